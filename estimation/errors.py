@@ -1,0 +1,23 @@
+"""Exceptions of pitotcal. The CLI maps each to one stderr line and an exit status."""
+
+__all__ = ["PitotcalError", "FlightDataError", "ObservabilityError", "PlanInfeasibleError"]
+
+
+class PitotcalError(ValueError):
+    """Base of our input errors; `exit_status` is what the CLI exits with."""
+
+    exit_status = 2
+
+
+class FlightDataError(PitotcalError):
+    """Unusable flight data; the message names file, column and row ("f.csv: column qc_pa, row 12: NaN")."""
+
+
+class ObservabilityError(PitotcalError):
+    """The data cannot separate the wind from the calibration (INTERFACES §3, exit 3)."""
+
+    exit_status = 3
+
+
+class PlanInfeasibleError(PitotcalError):
+    """A maneuver request that cannot be met; the message names the constraint and a value that works."""

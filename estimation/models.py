@@ -1,0 +1,85 @@
+"""Pressure-error model structures, Δp/q_c = f(q_ci; k) (INTERFACES §2, paper eq. 4).
+
+Each structure is a `PressureErrorModel` in `MODELS`. To add one, write its ratio with plain
+arithmetic (it is evaluated on numpy arrays and on CasADi MX vectors alike) and register it.
+"""
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+__all__ = ["PressureErrorModel", "MODELS", "get_model", "qci_from_qc_pa", "qc_from_qci_pa"]
+
+
+@dataclass(frozen=True)
+class PressureErrorModel:
+    """One structure of the normalized pressure error Δp/q_c as a function of q_ci.
+
+    Attributes
+    ----------
+    name : str
+        Name used on the command line and in the JSON (`constant`, `linear`, `inverse`).
+    params : tuple of str
+        Coefficient names in order, e.g. ("k1", "k2").
+    units : tuple of str
+        Unit of each coefficient ("" for dimensionless).
+    scales : tuple of float
+        Typical magnitude of each coefficient; the optimizer works on k / scale.
+    ratio : callable
+        ratio(k, qci_pa) -> Δp/q_c; `k` is a sequence of coefficients.
+    formula : str
+        The formula, for reports.
+    """
+
+    name: str
+    params: tuple
+    units: tuple
+    scales: tuple
+    ratio: Callable
+    formula: str
+
+    def __call__(self, k, qci_pa):
+        return self.ratio(k, qci_pa)
+
+
+MODELS = {
+    m.name: m for m in (
+        PressureErrorModel("constant", ("k1",), ("",), (0.01,),
+                           lambda k, q: k[0] + 0.0 * q, "dp/qc = k1"),
+        PressureErrorModel("linear", ("k1", "k2"), ("", "1/Pa"), (0.01, 1e-5),
+                           lambda k, q: k[0] + k[1] * q, "dp/qc = k1 + k2*qci"),
+        PressureErrorModel("inverse", ("k1", "k2"), ("", "Pa"), (0.01, 10.0),
+                           lambda k, q: k[0] + k[1] / q, "dp/qc = k1 + k2/qci"),
+    )
+}
+
+
+def get_model(name):
+    """The registered structure called `name`; ValueError naming the choices otherwise."""
+    try:
+        return MODELS[name]
+    except (KeyError, TypeError):
+        raise ValueError(f"model {name!r} is not one of {', '.join(MODELS)}") from None
+
+
+def qc_from_qci_pa(model, k, qci_pa):
+    """True impact pressure from the measured one: q_c = q_ci / (1 - f(q_ci)) (from eq. 1)."""
+    qci = np.asarray(qci_pa, dtype=float)
+    return qci / (1.0 - model(k, qci))
+
+
+def qci_from_qc_pa(model, k, qc_pa, iterations=50):
+    """Measured impact pressure a sensor with this error model reads at true q_c.
+
+    Solves q_ci = q_c (1 - f(q_ci)) by fixed-point iteration; it contracts because
+    |q_ci f'(q_ci)| << 1 for any physical pressure error.
+    """
+    qc = np.asarray(qc_pa, dtype=float)
+    qci = qc * (1.0 - model(k, qc))
+    for _ in range(iterations):
+        new = qc * (1.0 - model(k, qci))
+        if np.max(np.abs(new - qci), initial=0.0) < 1e-12 * max(1.0, np.max(np.abs(qc), initial=0.0)):
+            return new
+        qci = new
+    return qci

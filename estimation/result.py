@@ -1,0 +1,156 @@
+"""`IdentificationResult`: what `identify` returns, with the airspeed-correction table."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .models import get_model
+from .units import RHO0_KGM3, mps_to_kt, kt_to_mps
+
+__all__ = ["IdentificationResult"]
+
+WIND_NAMES = ("wind_speed_mps", "wind_from_deg")
+WIND_INTERNAL = ("wind_n_mps", "wind_e_mps")   # wind velocity vector (the way it blows TO)
+
+
+@dataclass(frozen=True)
+class IdentificationResult:
+    """Outcome of an output-error identification.
+
+    Attributes
+    ----------
+    model : str
+        Pressure-error structure (`estimation.models.MODELS`).
+    param_names : tuple of str
+        Reported parameters: the model's coefficients, then `wind_speed_mps`, `wind_from_deg`.
+    params : ndarray, shape (p,)
+    covariance : ndarray, shape (p, p)
+        Covariance corrected for colored residuals; `std` and every 2-sigma band use it.
+    covariance_plain : ndarray, shape (p, p)
+        Plain Hessian (Cramer-Rao) covariance s^2 (J^T J)^-1, for comparison.
+    internal_params, internal_covariance, internal_covariance_plain : ndarray
+        The same in the solver's parameters: coefficients, `wind_n_mps`, `wind_e_mps`.
+    success : bool
+        The solver converged (scipy `OptimizeResult` naming).
+    message : str
+        The solver's status.
+    iterations : int
+    n_samples : int
+    noise_std_pa : float
+        RMS of the residuals, Pa.
+    gps_noise_std_mps : float
+        GPS velocity noise sigma_v used for the errors-in-variables correction, m/s.
+    time_s, qci_pa, rho_kgm3, residuals_pa : ndarray, shape (N,)
+        Data used and output residual q_ci - predicted q_ci, Pa.
+    warnings : tuple of str
+    candidates : tuple of dict
+        With `--model auto`: every structure tried and its criterion.
+    criterion : str or None
+        The information criterion used to choose among candidates.
+    timing_s : dict
+        Seconds spent in `build`, `solve`, `covariance`.
+    """
+
+    model: str
+    param_names: tuple
+    params: np.ndarray
+    covariance: np.ndarray
+    covariance_plain: np.ndarray
+    internal_params: np.ndarray
+    internal_covariance: np.ndarray
+    internal_covariance_plain: np.ndarray
+    success: bool
+    message: str
+    iterations: int
+    n_samples: int
+    noise_std_pa: float
+    gps_noise_std_mps: float
+    time_s: np.ndarray
+    qci_pa: np.ndarray
+    rho_kgm3: np.ndarray
+    residuals_pa: np.ndarray
+    warnings: tuple = ()
+    candidates: tuple = ()
+    criterion: str | None = None
+    timing_s: dict = field(default_factory=dict)
+
+    # --- derived quantities -------------------------------------------------------------
+    @property
+    def converged(self):
+        return self.success
+
+    @property
+    def std(self):
+        return np.sqrt(np.diag(self.covariance))
+
+    @property
+    def std_plain(self):
+        return np.sqrt(np.diag(self.covariance_plain))
+
+    @property
+    def correlation(self):
+        s = self.std
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return self.covariance / np.outer(s, s)
+
+    @property
+    def coefficients(self):
+        """The model's own coefficients (k1, k2, ...)."""
+        return self.internal_params[: len(get_model(self.model).params)]
+
+    def value(self, name):
+        return float(self.params[self.param_names.index(name)])
+
+    def stddev(self, name, plain=False):
+        cov = self.covariance_plain if plain else self.covariance
+        i = self.param_names.index(name)
+        return float(np.sqrt(cov[i, i]))
+
+    def pressure_error(self, qci_pa, plain=False):
+        """Δp/q_c at `qci_pa` and its 2-sigma half-width (delta method)."""
+        model = get_model(self.model)
+        k = self.coefficients
+        qci = np.asarray(qci_pa, dtype=float)
+        ratio = model(k, qci)
+        grad = _gradient(lambda kk: model(kk, qci), k)
+        return ratio, 2.0 * _band(grad, self._coef_cov(plain))
+
+    def delta_v_kt(self, vi_kt, plain=False):
+        """Airspeed correction ΔV = V_c - V_i (kt) at indicated `vi_kt` and its 2-sigma half-width.
+
+        V_i = sqrt(2 q_ci / rho0), V_c = sqrt(2 q_c / rho0), q_c = q_ci / (1 - f(q_ci)).
+        """
+        model = get_model(self.model)
+        k = self.coefficients
+        vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
+        qci = 0.5 * RHO0_KGM3 * vi_mps ** 2
+
+        def dv_kt(kk):
+            qc = qci / (1.0 - model(kk, qci))
+            return mps_to_kt(np.sqrt(2.0 * qc / RHO0_KGM3) - vi_mps)
+
+        grad = _gradient(dv_kt, k)
+        return dv_kt(k), 2.0 * _band(grad, self._coef_cov(plain))
+
+    def _coef_cov(self, plain):
+        n = len(get_model(self.model).params)
+        cov = self.internal_covariance_plain if plain else self.internal_covariance
+        return cov[:n, :n]
+
+
+def _gradient(fun, k):
+    """Central-difference gradient of a vector function of the coefficients, shape (len(k), ...)."""
+    k = np.asarray(k, dtype=float)
+    rows = []
+    for i in range(k.size):
+        h = 1e-6 * max(1.0, abs(k[i]))
+        up, dn = k.copy(), k.copy()
+        up[i] += h
+        dn[i] -= h
+        rows.append((fun(up) - fun(dn)) / (2 * h))
+    return np.array(rows)
+
+
+def _band(grad, cov):
+    """One-sigma of a derived quantity: sqrt(g^T C g) for each column of `grad`."""
+    return np.sqrt(np.maximum(np.einsum("i...,ij,j...->...", grad, cov, grad), 0.0))

@@ -1,0 +1,76 @@
+"""Unit conversions and atmosphere constants: the one place they live.
+
+SI inside the library; knots and feet only at the edges (reports, pilot cards, CLI options).
+"""
+
+import numpy as np
+
+__all__ = [
+    "KT_TO_MPS", "FT_TO_M", "RHO0_KGM3", "R_AIR_JKGK", "G0_MPS2", "NM_TO_M",
+    "kt_to_mps", "mps_to_kt", "ft_to_m", "m_to_ft",
+    "density_kgm3", "cas_from_qc_mps", "qc_from_cas_pa",
+    "isa_temperature_k", "isa_pressure_pa", "isa_density_kgm3",
+]
+
+KT_TO_MPS = 1852.0 / 3600.0          # international knot
+FT_TO_M = 0.3048
+NM_TO_M = 1852.0
+RHO0_KGM3 = 1.225                    # sea-level standard density (INTERFACES §2)
+R_AIR_JKGK = 287.05287               # specific gas constant of dry air (INTERFACES §1)
+G0_MPS2 = 9.80665
+
+
+def kt_to_mps(v_kt):
+    return np.multiply(v_kt, KT_TO_MPS)
+
+
+def mps_to_kt(v_mps):
+    return np.divide(v_mps, KT_TO_MPS)
+
+
+def ft_to_m(h_ft):
+    return np.multiply(h_ft, FT_TO_M)
+
+
+def m_to_ft(h_m):
+    return np.divide(h_m, FT_TO_M)
+
+
+def density_kgm3(ps_pa, oat_k):
+    """Air density from static pressure and outside air temperature, rho = p / (R T)."""
+    return np.asarray(ps_pa, dtype=float) / (R_AIR_JKGK * np.asarray(oat_k, dtype=float))
+
+
+def cas_from_qc_mps(qc_pa):
+    """Calibrated airspeed from impact pressure, V = sqrt(2 q / rho0) (INTERFACES §2).
+
+    Negative pressures give a negative speed of the same magnitude rather than NaN, so a
+    correction curve stays continuous near zero.
+    """
+    qc = np.asarray(qc_pa, dtype=float)
+    return np.sign(qc) * np.sqrt(2.0 * np.abs(qc) / RHO0_KGM3)
+
+
+def qc_from_cas_pa(cas_mps):
+    """Impact pressure of a calibrated airspeed, q = rho0 V^2 / 2."""
+    return 0.5 * RHO0_KGM3 * np.asarray(cas_mps, dtype=float) ** 2
+
+
+# International Standard Atmosphere, troposphere: for planning at an altitude (true airspeed
+# from calibrated) when no measured static pressure and temperature are at hand.
+ISA_T0_K = 288.15
+ISA_P0_PA = 101325.0
+ISA_LAPSE_KPM = 0.0065
+
+
+def isa_temperature_k(alt_m):
+    return ISA_T0_K - ISA_LAPSE_KPM * np.asarray(alt_m, dtype=float)
+
+
+def isa_pressure_pa(alt_m):
+    exponent = G0_MPS2 / (R_AIR_JKGK * ISA_LAPSE_KPM)
+    return ISA_P0_PA * (isa_temperature_k(alt_m) / ISA_T0_K) ** exponent
+
+
+def isa_density_kgm3(alt_m):
+    return density_kgm3(isa_pressure_pa(alt_m), isa_temperature_k(alt_m))

@@ -1,0 +1,43 @@
+"""Point-mass aircraft over flat earth, shared by the planner and the simulator.
+
+State x = [north_m, east_m, alt_m, heading_rad, tas_mps]; controls u = [bank_rad, accel_mps2,
+climb_mps]; wind w = [wind_n_mps, wind_e_mps], the air-mass velocity (the way it blows TO).
+Heading is the air-relative heading, unwrapped (never wrapped inside the model).
+
+    north' = V cos(psi) + w_n        east' = V sin(psi) + w_e        alt' = climb
+    psi'   = g tan(phi) / V          (coordinated turn)              V'   = accel
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from estimation.units import G0_MPS2
+
+__all__ = ["Limits", "STATE_NAMES", "CONTROL_NAMES", "rhs"]
+
+STATE_NAMES = ("north_m", "east_m", "alt_m", "heading_rad", "tas_mps")
+CONTROL_NAMES = ("bank_rad", "accel_mps2", "climb_mps")
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Flight limits shared by planner and simulator (defaults: the paper's T-2 case)."""
+
+    bank_max_deg: float = 30.0
+    roll_rate_max_dps: float = 10.0
+    accel_max_mps2: float = 1.0
+    climb_max_mps: float = 2.0
+    alt_tolerance_m: float = 15.24      # +-50 ft (paper section IV)
+    cas_tolerance_kt: float = 5.0       # +-5 KCAS (paper section IV)
+
+
+def rhs(x, u, w, lib=np):
+    """Time derivative of the state; `lib` is numpy or casadi (works on arrays or MX/SX).
+
+    Returns a tuple of the five derivatives (stack them with the library's own function).
+    """
+    _, _, _, psi, v = (x[i] for i in range(5))
+    phi, accel, climb = (u[i] for i in range(3))
+    return (v * lib.cos(psi) + w[0], v * lib.sin(psi) + w[1], climb,
+            G0_MPS2 * lib.tan(phi) / v, accel)

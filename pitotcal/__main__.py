@@ -1,0 +1,5 @@
+import sys
+
+from pitotcal.cli import main
+
+sys.exit(main())
