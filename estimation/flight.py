@@ -4,7 +4,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-__all__ = ["Flight"]
+__all__ = ["Flight", "write_flight_csv"]
 
 
 @dataclass(frozen=True)
@@ -62,3 +62,21 @@ class Flight:
 
 
 _ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m")
+
+
+def write_flight_csv(flight, path, comments=None):
+    """Write `flight` as a flight CSV (INTERFACES §1): `# key: value` lines, header, rows.
+
+    Density is written as `rho_kgm3`; the optional columns only when present.
+    """
+    columns = ["time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3"]
+    data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
+    for name in ("gps_vd_mps", "alt_m"):
+        if getattr(flight, name) is not None:
+            columns.append(name)
+            data.append(getattr(flight, name))
+    meta = {**flight.meta, **(comments or {})}
+    header = "".join(f"# {key}: {value}\n" for key, value in meta.items()) + ",".join(columns)
+    np.savetxt(path, np.column_stack(data), delimiter=",", header=header, comments="",
+               fmt=["%.4f"] + ["%.9g"] * (len(columns) - 1))
+    return path

@@ -132,6 +132,27 @@ class IdentificationResult:
         grad = _gradient(dv_kt, k)
         return dv_kt(k), 2.0 * _band(grad, self._coef_cov(plain))
 
+    # --- presentation (estimation/report.py) --------------------------------------------
+    def summary(self):
+        """Human summary in knots and degrees (what `pitotcal identify` prints)."""
+        from .report import summary
+        return summary(self)
+
+    def to_dict(self):
+        """The JSON of INTERFACES §3."""
+        from .report import to_dict
+        return to_dict(self)
+
+    def correction_table(self, step_kt=None):
+        """Airspeed-correction rows {vi_kt, dv_kt, dv_2sigma_kt} over the flown V_i range."""
+        from .report import correction_table
+        return correction_table(self, step_kt=step_kt)
+
+    def plot(self, path=None):
+        """The calibration figure (paper Figs. 7-8 style); saved to `path` when given."""
+        from .report import plot
+        return plot(self, path)
+
     def _coef_cov(self, plain):
         n = len(get_model(self.model).params)
         cov = self.internal_covariance_plain if plain else self.internal_covariance

@@ -1,0 +1,98 @@
+"""A small seeded generator of calibration flights with known truth, for the tests.
+
+The full simulator lives in `maneuvers.simulate`; this one is deliberately simple so the
+estimation tests do not depend on it: the aircraft turns at a constant rate while q sweeps
+uniformly from q_lo to q_hi; the air mass moves with the mean wind plus first-order
+Gauss-Markov (Dryden-like) turbulence; GPS may be slower (sample-and-hold) and noisy.
+"""
+
+import numpy as np
+
+from estimation.flight import Flight
+from estimation.models import get_model, qci_from_qc_pa
+from estimation.units import kt_to_mps, RHO0_KGM3
+
+
+def wind_vector(speed_mps, from_deg):
+    """(north, east) air-mass velocity of a wind of this speed blowing FROM `from_deg`."""
+    a = np.radians(from_deg)
+    return -speed_mps * np.cos(a), -speed_mps * np.sin(a)
+
+
+def synthetic_flight(seed=0, n=16000, rate_hz=50.0, model="inverse", k=(0.02, -15.0),
+                     wind_speed_mps=5.0, wind_from_deg=270.0, cas_kt=(70.0, 100.0),
+                     turns=3.0, turbulence_mps=0.0, turbulence_length_m=300.0,
+                     gps_rate_hz=None, gps_noise_mps=0.0, qc_noise_pa=0.3,
+                     quantization_pa=0.0, rho_kgm3=1.196, vertical=False):
+    """Return (Flight, truth); truth = {"model", "parameters": {...}, "k": tuple}.
+
+    `turns` is the number of full heading revolutions (0: straight and level, unobservable).
+    Truth wind is the time-average of the wind actually flown through (turbulence included).
+    """
+    rng = np.random.default_rng(seed)
+    dt = 1.0 / rate_hz
+    t = np.arange(n) * dt
+    frac = t / t[-1]
+    qlo, qhi = (0.5 * RHO0_KGM3 * kt_to_mps(v) ** 2 for v in cas_kt)
+    qc = qlo + (qhi - qlo) * frac                       # uniform in q (paper section IV)
+    tas = np.sqrt(2.0 * qc / rho_kgm3)
+    psi = 2.0 * np.pi * turns * frac + rng.uniform(0, 2 * np.pi)
+
+    wn0, we0 = wind_vector(wind_speed_mps, wind_from_deg)
+    turb = np.zeros((n, 2))
+    if turbulence_mps > 0:
+        tau = turbulence_length_m / np.mean(tas)
+        a = np.exp(-dt / tau)
+        e = rng.standard_normal((n, 2)) * turbulence_mps * np.sqrt(1 - a * a)
+        turb[0] = rng.standard_normal(2) * turbulence_mps
+        for i in range(1, n):
+            turb[i] = a * turb[i - 1] + e[i]
+    wn, we = wn0 + turb[:, 0], we0 + turb[:, 1]
+    vn = tas * np.cos(psi) + wn
+    ve = tas * np.sin(psi) + we
+    vd = 0.5 * np.sin(2 * np.pi * t / 30.0) if vertical else None
+    if vertical:
+        # climb rate adds to the true airspeed magnitude: keep q_c consistent with it
+        tas_h = np.sqrt(np.maximum(tas ** 2 - vd ** 2, 1.0))
+        vn = tas_h * np.cos(psi) + wn
+        ve = tas_h * np.sin(psi) + we
+
+    gps_n, gps_e = vn.copy(), ve.copy()
+    if gps_noise_mps > 0:
+        held = _hold_index(t, gps_rate_hz)
+        noise = rng.standard_normal((n, 2)) * gps_noise_mps
+        gps_n += noise[held, 0]
+        gps_e += noise[held, 1]
+    if gps_rate_hz:
+        held = _hold_index(t, gps_rate_hz)
+        gps_n, gps_e = gps_n[held], gps_e[held]
+
+    m = get_model(model)
+    qci = qci_from_qc_pa(m, k, qc) + rng.standard_normal(n) * qc_noise_pa
+    if quantization_pa > 0:
+        qci = np.round(qci / quantization_pa) * quantization_pa
+
+    flight = Flight(time_s=t, qci_pa=qci, gps_vn_mps=gps_n, gps_ve_mps=gps_e,
+                    rho_kgm3=np.full(n, rho_kgm3), gps_vd_mps=vd, source=f"synthetic(seed={seed})")
+    mean_n, mean_e = wn.mean(), we.mean()
+    truth = {
+        "model": model,
+        "k": tuple(k),
+        "parameters": {
+            **dict(zip(m.params, k)),
+            "wind_speed_mps": float(np.hypot(mean_n, mean_e)),
+            "wind_from_deg": float(np.degrees(np.arctan2(-mean_e, -mean_n)) % 360.0),
+        },
+        "wind_n_mps": float(mean_n),
+        "wind_e_mps": float(mean_e),
+    }
+    return flight, truth
+
+
+def _hold_index(t, rate_hz):
+    """Index of the latest sample at or before each GPS update time (sample-and-hold)."""
+    if not rate_hz:
+        return np.arange(t.size)
+    period = 1.0 / rate_hz
+    tick = np.floor((t - t[0]) / period + 1e-9) * period + t[0]
+    return np.searchsorted(t, tick - 1e-9)
