@@ -1,0 +1,61 @@
+"""The Monte Carlo engine: seeds, failed runs as rows, serial and Dask paths give equal rows."""
+
+import math
+
+import pytest
+
+from studies.runner import SERIAL_BELOW, echo_task, read_table, run_cases, run_one, write_table
+
+
+def _cases(n, fail_at=()):
+    return [{"value": float(i), "fail": i in fail_at} for i in range(n)]
+
+
+def test_serial_rows_seeds_and_failures():
+    rows = run_cases(echo_task, _cases(5, fail_at={3}), base_seed=100, workers=0)
+    assert [r["run_index"] for r in rows] == [0, 1, 2, 3, 4]
+    assert [r["seed"] for r in rows] == [100, 101, 102, 103, 104]
+    assert rows[2]["twice_seed"] == 204 and rows[2]["error"] == ""
+    assert rows[3]["error"] == "RuntimeError: run with seed 103 failed on purpose"
+    assert "twice_seed" not in rows[3]
+
+
+def test_seed_offset_shares_seeds_and_run_one_repeats():
+    cases = [{"value": 1.0, "seed_offset": 7}, {"value": 2.0, "seed_offset": 7}, {"value": 3.0}]
+    rows = run_cases(echo_task, cases, base_seed=10, workers=0)
+    assert [r["seed"] for r in rows] == [17, 17, 12]
+    again = run_one(echo_task, cases, 1, base_seed=10)
+    assert again[0]["seed"] == 17 and again[0]["value"] == 2.0
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"workers": -1}, "workers must be an integer >= 0"),
+    ({"workers": 1.5}, "workers must be an integer >= 0"),
+])
+def test_bad_arguments(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        run_cases(echo_task, _cases(2), **kwargs)
+
+
+def test_run_one_bad_index():
+    with pytest.raises(ValueError, match="run index 9 is outside 0..1"):
+        run_one(echo_task, _cases(2), 9)
+
+
+def test_dask_local_cluster_matches_serial():
+    n = SERIAL_BELOW + 2
+    cases = _cases(n, fail_at={5})
+    seen = []
+    rows = run_cases(echo_task, cases, base_seed=3, workers=2,
+                     progress=lambda done, total: seen.append((done, total)))
+    serial = run_cases(echo_task, cases, base_seed=3, workers=0)
+    strip = [{k: v for k, v in r.items() if k != "elapsed_s"} for r in rows]
+    assert strip == [{k: v for k, v in r.items() if k != "elapsed_s"} for r in serial]
+    assert seen[-1] == (n, n) and len(seen) == n
+
+
+def test_table_round_trip(tmp_path):
+    rows = [{"a": 1.0, "b": "x"}, {"a": float("nan"), "c": 2.5}]
+    back = read_table(write_table(rows, tmp_path / "t.csv"))
+    assert back[0]["a"] == 1.0 and back[0]["b"] == "x" and math.isnan(back[0]["c"])
+    assert math.isnan(back[1]["a"]) and back[1]["c"] == 2.5
