@@ -1,0 +1,78 @@
+"""Errors in variables: the GPS velocity noise sigma_v, estimated from the data.
+
+GPS velocity noise enters the predicted impact pressure squared (q_c = rho |V_g - W|^2 / 2), so
+it does not average out: it biases k1, k2 by about rho sigma_v^2 / q_c (MEASURED.md). The
+output-error problem removes that bias when it knows sigma_v (estimation/oe.py, Notes); this
+module estimates sigma_v from the velocity's high-frequency content.
+"""
+
+import logging
+
+import numpy as np
+
+__all__ = ["gps_update_mask", "estimate_gps_noise_std"]
+
+log = logging.getLogger(__name__)
+
+# Fewer distinct GPS updates than this give a noise estimate too rough to be worth using.
+MIN_UPDATES = 30
+
+
+def gps_update_mask(*channels):
+    """Samples where a new GPS fix arrived, shape (N,) bool.
+
+    GPS is often logged at 5 Hz inside 50 Hz data as sample-and-hold: a fix repeats until the
+    next one. A sample is an update when any velocity channel differs from the previous sample;
+    the first sample is always an update.
+
+    Parameters
+    ----------
+    *channels : ndarray, shape (N,)
+        Velocity components, m/s (north, east[, down]).
+    """
+    changed = np.zeros(channels[0].size, dtype=bool)
+    changed[0] = True
+    for c in channels:
+        changed[1:] |= np.diff(c) != 0.0
+    return changed
+
+
+def estimate_gps_noise_std(time_s, *channels):
+    """White-noise standard deviation of one GPS velocity component, m/s.
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+        Sample times, s (only the update samples' order matters).
+    *channels : ndarray, shape (N,)
+        GPS velocity components, m/s.
+
+    Returns
+    -------
+    float
+        sigma_v, m/s (0.0 when it cannot be told from the motion).
+
+    Notes
+    -----
+    On the distinct updates only (sample-and-hold repeats would fake a smooth signal), the
+    variogram of each component, gamma(h) = mean((v[i+h] - v[i])^2) / 2 for h = 1, 2, 3, is
+    fitted by gamma(h) = sigma_v^2 + a h + b h^2 and extrapolated to h = 0 (the "nugget").
+    White noise is the only part that does not vanish at lag 0: smooth turning motion grows as
+    h^2 and Gauss-Markov turbulence or a random walk as h, so neither leaks into sigma_v,
+    unlike a plain second- or third-difference variance (which sees the turbulence's
+    increments). The channels' estimates are pooled (one noise level per receiver).
+    """
+    del time_s   # the variogram is taken in update counts; GPS updates are regular
+    update = gps_update_mask(*channels)
+    if update.sum() < MIN_UPDATES:
+        log.info("only %d GPS updates: GPS noise not estimated", update.sum())
+        return 0.0
+    lags = np.arange(1, 4)
+    design = np.column_stack([np.ones(lags.size), lags, lags ** 2])
+    nugget = []
+    for c in channels:
+        v = c[update]
+        gamma = np.array([0.5 * np.mean((v[h:] - v[:-h]) ** 2) for h in lags])
+        nugget.append(np.linalg.solve(design, gamma)[0])
+    var = float(np.mean(nugget))
+    return float(np.sqrt(var)) if var > 0 else 0.0
