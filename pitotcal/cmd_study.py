@@ -1,0 +1,75 @@
+"""`pitotcal study NAME [--runs N] [--out DIR] [--scheduler ADDRESS]` (INTERFACES §7)."""
+
+import sys
+
+STUDIES = ("sample-size", "maneuvers", "sensitivity", "coverage", "wind", "real-alfa", "peers")
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "study", help="run a Monte Carlo study (table, summary, figures)",
+        description="Run one named study on a local Dask cluster (all cores), an existing "
+                    "scheduler (--scheduler), or in process (--workers 0); write DIR/NAME.csv "
+                    "(one row per run), DIR/NAME.json (summary) and DIR/NAME*.png.")
+    p.add_argument("name", choices=STUDIES, metavar="NAME", help=", ".join(STUDIES))
+    p.add_argument("--runs", type=int, default=None,
+                   help="Monte Carlo replicates per case (coverage: number of flights); "
+                        "default: the study's own")
+    p.add_argument("--out", default=".", help="output folder (default: .)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="address of an existing Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: all cores; 0: run in this process)")
+    p.add_argument("--seed", type=int, default=0, help="base seed; run i uses the table's seed")
+    p.add_argument("--quick", action="store_true", help="small grid (smoke runs, CI)")
+    p.add_argument("--run-index", type=int, default=None, metavar="I",
+                   help="repeat run I alone (same --runs/--seed/--quick as the study); "
+                        "prints its rows as JSON")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    import json
+
+    from studies.catalog import rerun, run_study
+
+    if args.run_index is not None:
+        rows = rerun(args.name, args.run_index, runs=args.runs, seed=args.seed, quick=args.quick)
+        print(json.dumps(rows, indent=2, default=str))
+        return 1 if any(r.get("error") for r in rows) else 0
+    summary = run_study(args.name, runs=args.runs, out_dir=args.out, seed=args.seed,
+                        workers=args.workers, scheduler=args.scheduler, quick=args.quick,
+                        progress=_Bar(args.name) if sys.stderr.isatty() else _Counter(args.name))
+    print(f"study {args.name}: {summary.get('n_runs', '?')} runs, "
+          f"{summary.get('n_failed', 0)} failed, {summary.get('elapsed_s', '?')} s")
+    for key in ("coverage_2sigma", "coverage_2sigma_uncorrected"):
+        if summary.get(key) is not None:
+            print(f"  {key}: {summary[key]:.3f}")
+    for path in summary.get("files", []):
+        print(f"  wrote {path}")
+    return 0
+
+
+class _Bar:
+    """A one-line progress bar on stderr (redrawn in place)."""
+
+    def __init__(self, name, width=30):
+        self.name, self.width = name, width
+
+    def __call__(self, done, total):
+        filled = int(self.width * done / total)
+        end = "\n" if done == total else ""
+        sys.stderr.write(f"\r{self.name} [{'#' * filled}{'.' * (self.width - filled)}] "
+                         f"{done}/{total}{end}")
+        sys.stderr.flush()
+
+
+class _Counter:
+    """Progress for logs and pipes: a line every 10% of the runs."""
+
+    def __init__(self, name):
+        self.name = name
+
+    def __call__(self, done, total):
+        if done == total or done % max(1, total // 10) == 0:
+            sys.stderr.write(f"{self.name}: {done}/{total} runs\n")

@@ -1,0 +1,210 @@
+"""What every study run does: plan (cached), fly, identify, and score the result against truth.
+
+Only the public API of `maneuvers` and `estimation` is used. Plans and flights are cached per
+process (a Dask worker keeps its cache between runs), so a sweep that re-identifies one flight
+several ways, or flies one plan many times, plans and simulates once.
+"""
+
+import functools
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from estimation.models import get_model, qc_from_qci_pa
+from estimation.units import RHO0_KGM3, kt_to_mps, mps_to_kt
+
+__all__ = ["T2_PLAN", "get_plan", "fly", "identify_flight", "score", "true_delta_v_kt",
+           "wrap_deg", "first_seconds", "run_fly_identify", "Study", "ok_rows", "column",
+           "group", "stats", "new_figure", "save"]
+
+# The reference paper's T-2 case (section IV): continuous 70-100 KCAS, 0.5 nm, 800 ft, 240 s.
+T2_PLAN = {"profile": "continuous", "cas_min_kt": 70.0, "cas_max_kt": 100.0, "radius_m": 926.0,
+           "altitude_m": 244.0, "duration_s": 240.0, "bank_max_deg": 30.0,
+           "wind_speed_mps": 5.0, "wind_from_deg": 270.0}
+
+N_DV_GRID = 7   # points of the V_i grid on which ΔV is scored
+
+
+def _key(mapping):
+    return json.dumps(mapping or {}, sort_keys=True)
+
+
+def get_plan(**plan_kwargs):
+    """`maneuvers.plan_maneuver(**plan_kwargs)`, cached per process (T-2 defaults filled in)."""
+    return _plan_cached(_key({**T2_PLAN, **plan_kwargs}))
+
+
+@functools.lru_cache(maxsize=32)
+def _plan_cached(key):
+    from maneuvers.planner import plan_maneuver
+    return plan_maneuver(**json.loads(key))
+
+
+def fly(plan_kwargs=None, sim_kwargs=None, seed=0):
+    """(Flight, truth) of `maneuvers.simulate` on the (cached) plan; cached per process."""
+    return _fly_cached(_key({**T2_PLAN, **(plan_kwargs or {})}), _key(sim_kwargs), int(seed))
+
+
+@functools.lru_cache(maxsize=4)
+def _fly_cached(plan_key, sim_key, seed):
+    from maneuvers.simulator import simulate
+    sim = json.loads(sim_key)
+    for name in ("k", "wind_drift_mps2"):      # JSON turned tuples into lists
+        if name in sim:
+            sim[name] = tuple(sim[name])
+    return simulate(_plan_cached(plan_key), seed=seed, **sim)
+
+
+def identify_flight(flight, model="inverse"):
+    """`estimation.identify` with the study defaults (GPS noise estimated from the data)."""
+    from estimation.identify import identify
+    return identify(flight, model=model)
+
+
+def first_seconds(flight, seconds):
+    """The first `seconds` of a flight (all of it when None)."""
+    if seconds is None:
+        return flight
+    return flight.window(flight.time_s[0], flight.time_s[0] + float(seconds))
+
+
+def wrap_deg(angle_deg):
+    """An angle difference wrapped to [-180, 180)."""
+    return (np.asarray(angle_deg, dtype=float) + 180.0) % 360.0 - 180.0
+
+
+def true_delta_v_kt(model, k, vi_kt):
+    """Truth ΔV = V_c - V_i (kt) at indicated `vi_kt` for pressure-error `model` with coefficients `k`."""
+    m = get_model(model)
+    vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
+    qci = 0.5 * RHO0_KGM3 * vi_mps ** 2
+    qc = qc_from_qci_pa(m, k, qci)
+    return mps_to_kt(np.sqrt(2.0 * qc / RHO0_KGM3) - vi_mps)
+
+
+def score(result, truth, flight=None):
+    """Flat row: estimates, 1-σ (corrected and plain), truth, error and z of every parameter,
+    and the airspeed correction ΔV against truth over the flown V_i range.
+
+    Columns: ``success``, ``iterations``, ``n_samples``, ``noise_std_pa``; for each parameter P
+    reported by both: ``P``, ``P_std``, ``P_std_plain``, ``P_true``, ``P_err`` (direction wrapped
+    to ±180°), ``P_z``, ``P_z_plain``; ``dv_err_max_kt`` (largest |ΔV error| on the grid),
+    ``dv_2sigma_max_kt``, ``dv_2sigma_mean_kt``, ``dv_inside_2sigma`` (fraction of grid points
+    whose truth lies inside ±2σ), ``dv_true_mean_kt``, ``vi_min_kt``, ``vi_max_kt``.
+    """
+    truth_params = truth["parameters"]
+    row = {"success": bool(result.success), "iterations": int(result.iterations),
+           "n_samples": int(result.n_samples), "noise_std_pa": float(result.noise_std_pa)}
+    for i, name in enumerate(result.param_names):
+        if name not in truth_params or truth_params[name] is None:
+            continue
+        est, true = float(result.params[i]), float(truth_params[name])
+        std = float(np.sqrt(result.covariance[i, i]))
+        std_plain = float(np.sqrt(result.covariance_plain[i, i]))
+        err = float(wrap_deg(est - true)) if name.endswith("_deg") else est - true
+        row.update({name: est, f"{name}_std": std, f"{name}_std_plain": std_plain,
+                    f"{name}_true": true, f"{name}_err": err,
+                    f"{name}_z": err / std if std > 0 else float("nan"),
+                    f"{name}_z_plain": err / std_plain if std_plain > 0 else float("nan")})
+    qci = result.qci_pa if flight is None else flight.qci_pa
+    vi_kt = mps_to_kt(np.sqrt(2.0 * np.maximum(qci, 0.0) / RHO0_KGM3))
+    lo, hi = np.percentile(vi_kt, [2.0, 98.0])
+    grid = np.linspace(lo, hi, N_DV_GRID)
+    dv, dv_2s = result.delta_v_kt(grid)
+    true_model = get_model(truth["model"])
+    dv_true = true_delta_v_kt(truth["model"], [truth_params[p] for p in true_model.params], grid)
+    err = np.abs(dv - dv_true)
+    row.update({"dv_err_max_kt": float(err.max()), "dv_2sigma_max_kt": float(dv_2s.max()),
+                "dv_2sigma_mean_kt": float(dv_2s.mean()),
+                "dv_inside_2sigma": float(np.mean(err <= dv_2s)),
+                "dv_true_mean_kt": float(dv_true.mean()),
+                "vi_min_kt": float(lo), "vi_max_kt": float(hi)})
+    return row
+
+
+def run_fly_identify(seed, plan=None, sim=None, model="inverse", seconds=None):
+    """Plan, fly and identify one flight (optionally only its first `seconds`); the scored row."""
+    flight, truth = fly(plan, sim, seed)
+    used = first_seconds(flight, seconds)
+    return score(identify_flight(used, model), truth, used)
+
+
+# --- the shape of a study, and small helpers for summaries and figures ----------------------
+
+@dataclass(frozen=True)
+class Study:
+    """One named study: its cases, the per-run task, the summary and the figures.
+
+    Attributes
+    ----------
+    name : str
+        Name on the command line (`pitotcal study NAME`) and of the output files.
+    description : str
+    task : callable
+        Module-level ``task(seed=..., **case) -> dict or list of dict``.
+    cases : callable
+        ``cases(runs, quick) -> list of dict``; `runs` is the number of Monte Carlo
+        replicates per case; `quick` shrinks the grid for tests and smoke runs.
+    summarize : callable
+        ``summarize(rows) -> dict`` (JSON-ready).
+    plot : callable
+        ``plot(rows, summary, out_dir) -> list of paths`` of the `NAME*.png` figures.
+    default_runs, quick_runs : int
+        Replicates per case when `runs` is not given.
+    """
+
+    name: str
+    description: str
+    task: Callable
+    cases: Callable
+    summarize: Callable
+    plot: Callable
+    default_runs: int = 10
+    quick_runs: int = 1
+
+
+def ok_rows(rows):
+    """The rows of runs that finished (no error) and whose solver converged."""
+    return [r for r in rows if not r.get("error") and r.get("success", True) is True]
+
+
+def column(rows, name):
+    """Values of one column as a float array (missing -> NaN)."""
+    return np.array([float(r.get(name, np.nan)) if r.get(name) is not None else np.nan
+                     for r in rows], dtype=float)
+
+
+def group(rows, *keys):
+    """Rows grouped by the values of `keys`, in first-seen order: {(v1, ...): [rows]}."""
+    out = {}
+    for r in rows:
+        out.setdefault(tuple(r.get(k) for k in keys), []).append(r)
+    return out
+
+
+def stats(rows, name):
+    """{median, mean, rms, p95_abs, n} of a column over finite values (NaN when none)."""
+    x = column(rows, name)
+    x = x[np.isfinite(x)]
+    if x.size == 0:
+        return {"median": None, "mean": None, "rms": None, "p95_abs": None, "n": 0}
+    return {"median": float(np.median(x)), "mean": float(np.mean(x)),
+            "rms": float(np.sqrt(np.mean(x ** 2))),
+            "p95_abs": float(np.percentile(np.abs(x), 95.0)), "n": int(x.size)}
+
+
+def new_figure(nrows=1, ncols=1, size=(6.0, 4.0)):
+    """A matplotlib Figure without pyplot (no GUI backend, safe in workers and CI)."""
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=(size[0] * ncols, size[1] * nrows), layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=False)
+    return fig, axes
+
+
+def save(fig, out_dir, filename):
+    path = Path(out_dir) / filename
+    fig.savefig(path, dpi=110)
+    return str(path)

@@ -1,0 +1,77 @@
+"""`maneuvers` (paper Figs. 10-11): step-and-pause vs continuous vs two-speed, 70-100 KCAS.
+
+For each profile and flight time the maneuver is planned (T-2 case otherwise), flown and
+identified; a replicate uses the same seed for every profile and time (common random numbers),
+so the curves differ by the maneuver, not by the luck of the draw. A profile that cannot be
+planned in that time is a row with the planner's message.
+"""
+
+import numpy as np
+
+from .common import Study, group, new_figure, ok_rows, run_fly_identify, save, stats
+
+__all__ = ["STUDY", "PROFILES", "DURATIONS_S"]
+
+PROFILES = ("step-pause", "continuous", "two-speed")
+DURATIONS_S = (180.0, 210.0, 240.0, 300.0, 360.0, 480.0)
+QUICK_DURATIONS_S = (240.0,)
+
+
+def task(seed, profile, duration_s):
+    return run_fly_identify(seed, plan={"profile": profile, "duration_s": duration_s})
+
+
+def cases(runs, quick):
+    durations = QUICK_DURATIONS_S if quick else DURATIONS_S
+    return [{"profile": p, "duration_s": d, "seed_offset": r}
+            for r in range(runs) for p in PROFILES for d in durations]
+
+
+def summarize(rows):
+    out = {}
+    for (profile, duration), rs in group(rows, "profile", "duration_s").items():
+        good = ok_rows(rs)
+        out.setdefault(profile, {})[str(int(duration))] = {
+            "n_runs": len(rs), "n_ok": len(good),
+            "dv_2sigma_max_kt": stats(good, "dv_2sigma_max_kt")["median"],
+            "dv_err_max_kt_rms": stats(good, "dv_err_max_kt")["rms"],
+            "dv_inside_2sigma": stats(good, "dv_inside_2sigma")["mean"],
+            "wind_speed_err_rms_mps": stats(good, "wind_speed_mps_err")["rms"],
+            "wind_from_err_rms_deg": stats(good, "wind_from_deg_err")["rms"],
+            "errors": sorted({r["error"] for r in rs if r.get("error")})}
+    return {"by_profile": out, "best_at_240s": _best(out, "240")}
+
+
+def _best(by_profile, duration):
+    """The profile with the smallest median 2σ of ΔV at this flight time, or None."""
+    scored = [(v[duration]["dv_2sigma_max_kt"], p) for p, v in by_profile.items()
+              if duration in v and v[duration]["dv_2sigma_max_kt"] is not None]
+    return min(scored)[1] if scored else None
+
+
+def plot(rows, summary, out_dir):
+    fig, ax = new_figure(1, 2, size=(5.0, 3.8))
+    for profile, marker in zip(PROFILES, "osD"):
+        entry = summary["by_profile"].get(profile, {})
+        t = sorted(float(k) for k in entry)
+        two_sigma = [entry[str(int(x))]["dv_2sigma_max_kt"] for x in t]
+        err = [entry[str(int(x))]["dv_err_max_kt_rms"] for x in t]
+        ax[0, 0].plot(t, _nan(two_sigma), marker + "-", label=profile)
+        ax[0, 1].plot(t, _nan(err), marker + "-", label=profile)
+    ax[0, 0].set_ylabel("2σ of ΔV (largest over the speed range), kt")
+    ax[0, 1].set_ylabel("ΔV error vs truth (rms over runs of the largest), kt")
+    for a in ax.flat:
+        a.set_xlabel("flight time, s")
+        a.set_yscale("log")
+        a.axhline(0.2, color="0.5", ls=":", lw=0.8)
+        a.legend(fontsize=8)
+    fig.suptitle("Calibration maneuvers, 70-100 KCAS (dotted: the paper's 0.2 kt)")
+    return [save(fig, out_dir, "maneuvers.png")]
+
+
+def _nan(values):
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+
+STUDY = Study("maneuvers", "step-pause vs continuous vs two-speed: 2σ of ΔV and error vs time",
+              task, cases, summarize, plot, default_runs=10, quick_runs=1)

@@ -1,0 +1,95 @@
+"""`sensitivity`: accuracy and 2-σ of the calibration versus one factor at a time.
+
+Factors (the paper's "important influences" and its open questions): GPS velocity noise and
+rate, transducer noise, calibration bias and scale error, turbulence intensity, data rate
+5-200 Hz, wind drift during the maneuver, pneumatic lag, test-area radius and bank limit. All
+other settings stay at the T-2 baseline (the simulator's realistic defaults). Replicate r uses
+the same seed at every level of every factor (common random numbers), so a curve shows the
+factor's effect rather than sampling noise.
+"""
+
+import numpy as np
+
+from .common import Study, group, new_figure, ok_rows, run_fly_identify, save, stats
+
+__all__ = ["STUDY", "FACTORS"]
+
+# name -> (where: "sim" or "plan", keyword, levels, label); wind drift is (north, 0) m/s².
+FACTORS = {
+    "gps_noise_mps": ("sim", "gps_noise_mps", (0.0, 0.05, 0.1, 0.2, 0.5), "GPS velocity noise, m/s"),
+    "gps_rate_hz": ("sim", "gps_rate_hz", (1.0, 2.0, 5.0, 10.0, 20.0), "GPS rate, Hz"),
+    "qc_noise_pa": ("sim", "qc_noise_pa", (0.1, 0.5, 1.0, 2.0, 5.0), "transducer noise, Pa"),
+    "qc_bias_pa": ("sim", "qc_bias_pa", (0.0, 1.0, 2.0, 5.0, 10.0), "transducer bias, Pa"),
+    "qc_scale_error": ("sim", "qc_scale_error", (0.0, 0.005, 0.01, 0.02), "transducer scale error"),
+    "turbulence_mps": ("sim", "turbulence_mps", (0.0, 0.25, 0.5, 1.0, 2.0), "turbulence σ, m/s"),
+    "rate_hz": ("sim", "rate_hz", (5.0, 10.0, 25.0, 50.0, 100.0, 200.0), "data rate, Hz"),
+    "wind_drift_mps2": ("sim", "wind_drift_mps2", (0.0, 0.002, 0.005, 0.01, 0.02),
+                        "wind drift, m/s²"),
+    "pneumatic_lag_s": ("sim", "pneumatic_lag_s", (0.0, 0.05, 0.1, 0.2, 0.5), "pneumatic lag, s"),
+    "radius_m": ("plan", "radius_m", (550.0, 700.0, 926.0, 1200.0), "test-area radius, m"),
+    "bank_max_deg": ("plan", "bank_max_deg", (20.0, 25.0, 30.0, 35.0, 45.0), "bank limit, deg"),
+}
+
+
+def task(seed, factor, level):
+    where, key, _, _ = FACTORS[factor]
+    value = (level, 0.0) if key == "wind_drift_mps2" else level
+    if where == "plan":
+        return run_fly_identify(seed, plan={key: value})
+    return run_fly_identify(seed, sim={key: value})
+
+
+def cases(runs, quick):
+    out = []
+    for r in range(runs):
+        for factor, (_, _, levels, _) in FACTORS.items():
+            for level in ((levels[0], levels[-1]) if quick else levels):
+                out.append({"factor": factor, "level": float(level), "seed_offset": r})
+    return out
+
+
+def summarize(rows):
+    out = {}
+    for (factor, level), rs in group(rows, "factor", "level").items():
+        good = ok_rows(rs)
+        out.setdefault(factor, {"label": FACTORS[factor][3], "levels": []})["levels"].append({
+            "level": level, "n_runs": len(rs), "n_ok": len(good),
+            "dv_2sigma_max_kt": stats(good, "dv_2sigma_max_kt")["median"],
+            "dv_err_max_kt_rms": stats(good, "dv_err_max_kt")["rms"],
+            "dv_inside_2sigma": stats(good, "dv_inside_2sigma")["mean"],
+            "k1_err_rms": stats(good, "k1_err")["rms"],
+            "k2_err_rms_pa": stats(good, "k2_err")["rms"],
+            "wind_speed_err_rms_mps": stats(good, "wind_speed_mps_err")["rms"],
+            "errors": sorted({r["error"] for r in rs if r.get("error")})})
+    return {"factors": out}
+
+
+def plot(rows, summary, out_dir):
+    factors = summary["factors"]
+    ncols = 4
+    nrows = max(1, int(np.ceil(len(factors) / ncols)))
+    fig, ax = new_figure(nrows, ncols, size=(3.6, 2.9))
+    for a, (factor, entry) in zip(ax.flat, factors.items()):
+        lv = entry["levels"]
+        x = np.array([e["level"] for e in lv], dtype=float)
+        two = np.array([np.nan if e["dv_2sigma_max_kt"] is None else e["dv_2sigma_max_kt"]
+                        for e in lv])
+        err = np.array([np.nan if e["dv_err_max_kt_rms"] is None else e["dv_err_max_kt_rms"]
+                        for e in lv])
+        a.plot(x, two, "o-", label="2σ of ΔV")
+        a.plot(x, err, "s--", label="ΔV error (rms)")
+        a.set_xlabel(entry["label"])
+        a.set_yscale("log")
+        if factor in ("rate_hz", "gps_rate_hz"):
+            a.set_xscale("log")
+        a.axhline(0.2, color="0.5", ls=":", lw=0.8)
+        a.legend(fontsize=7)
+    for a in list(ax.flat)[len(factors):]:
+        a.set_visible(False)
+    ax[0, 0].set_ylabel("kt (largest over the speed range)")
+    fig.suptitle("Sensitivity of the T-2 calibration, one factor at a time (dotted: 0.2 kt)")
+    return [save(fig, out_dir, "sensitivity.png")]
+
+
+STUDY = Study("sensitivity", "accuracy and 2σ of ΔV vs sensor, atmosphere and maneuver factors",
+              task, cases, summarize, plot, default_runs=5, quick_runs=1)

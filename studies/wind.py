@@ -1,0 +1,95 @@
+"""`wind` (paper Figs. 13-14): the estimated wind against the wind actually flown through.
+
+Each maneuver profile is planned for, and flown in, several mean winds (with the simulator's
+light turbulence). The flown wind is the time-average of the air-mass velocity along the path
+(the simulator's truth); the paper compared with a tethered balloon 1 nm away and found agreement
+within ~0.5 kt and ~4°.
+"""
+
+import numpy as np
+
+from estimation.units import mps_to_kt
+
+from .common import Study, column, group, new_figure, ok_rows, run_fly_identify, save, stats
+
+__all__ = ["STUDY", "WINDS", "PROFILES"]
+
+PROFILES = ("step-pause", "continuous", "two-speed")
+WINDS = ((2.0, 45.0), (5.0, 270.0), (8.0, 160.0), (10.0, 330.0))
+QUICK_WINDS = ((5.0, 270.0),)
+
+
+def task(seed, profile, wind_speed_mps, wind_from_deg):
+    wind = {"wind_speed_mps": wind_speed_mps, "wind_from_deg": wind_from_deg}
+    return run_fly_identify(seed, plan={"profile": profile, **wind}, sim=wind)
+
+
+def cases(runs, quick):
+    winds = QUICK_WINDS if quick else WINDS
+    return [{"profile": p, "wind_speed_mps": s, "wind_from_deg": d, "seed_offset": r}
+            for r in range(runs) for p in PROFILES for s, d in winds]
+
+
+def summarize(rows):
+    out = {}
+    for (profile,), rs in group(rows, "profile").items():
+        good = ok_rows(rs)
+        z_s, z_d = column(good, "wind_speed_mps_z"), column(good, "wind_from_deg_z")
+        out[profile] = {
+            "n_runs": len(rs), "n_ok": len(good),
+            "speed_err_rms_kt": _kt(stats(good, "wind_speed_mps_err")["rms"]),
+            "speed_err_max_kt": _kt(_absmax(column(good, "wind_speed_mps_err"))),
+            "direction_err_rms_deg": stats(good, "wind_from_deg_err")["rms"],
+            "direction_err_max_deg": _absmax(column(good, "wind_from_deg_err")),
+            "speed_2sigma_median_kt": _kt(_twice(stats(good, "wind_speed_mps_std")["median"])),
+            "direction_2sigma_median_deg": _twice(stats(good, "wind_from_deg_std")["median"]),
+            "inside_2sigma": _frac(np.concatenate([np.abs(z_s) <= 2, np.abs(z_d) <= 2]),
+                                   np.concatenate([z_s, z_d]))}
+    return {"by_profile": out,
+            "paper_agreement": {"speed_kt": 0.5, "direction_deg": 4.0,
+                                "note": "paper: OE vs tethered balloon 1 nm away"}}
+
+
+def _kt(v_mps):
+    return None if v_mps is None else float(mps_to_kt(v_mps))
+
+
+def _twice(v):
+    return None if v is None else 2.0 * v
+
+
+def _absmax(x):
+    x = x[np.isfinite(x)]
+    return float(np.max(np.abs(x))) if x.size else None
+
+
+def _frac(mask, values):
+    keep = np.isfinite(values)
+    return float(np.mean(mask[keep])) if keep.any() else None
+
+
+def plot(rows, summary, out_dir):
+    good = ok_rows(rows)
+    fig, ax = new_figure(1, 2, size=(4.6, 4.0))
+    for profile, marker in zip(PROFILES, "osD"):
+        rs = [r for r in good if r.get("profile") == profile]
+        if not rs:
+            continue
+        for a, p in ((ax[0, 0], "wind_speed_mps"), (ax[0, 1], "wind_from_deg")):
+            true, est, std = column(rs, f"{p}_true"), column(rs, p), column(rs, f"{p}_std")
+            if p == "wind_from_deg":        # plot near the truth across 0/360
+                est = true + ((est - true + 180.0) % 360.0 - 180.0)
+            a.errorbar(true, est, yerr=2 * std, fmt=marker, ms=4, capsize=2, alpha=0.8,
+                       label=profile)
+    for a, unit, title in ((ax[0, 0], "m/s", "wind speed"), (ax[0, 1], "deg", "wind from")):
+        lo, hi = a.get_xlim()
+        a.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+        a.set_xlabel(f"flown (time-average) {title}, {unit}")
+        a.set_ylabel(f"estimated {title} ± 2σ, {unit}")
+        a.legend(fontsize=8)
+    fig.suptitle("Estimated vs flown wind, per maneuver (paper Figs. 13-14)")
+    return [save(fig, out_dir, "wind.png")]
+
+
+STUDY = Study("wind", "estimated vs flown wind speed and direction, per maneuver",
+              task, cases, summarize, plot, default_runs=5, quick_runs=1)
