@@ -1,10 +1,60 @@
-"""Flight data: the `Flight` container (INTERFACES §1), its CSV reader and validator."""
+"""Flight data: the `Flight` container (INTERFACES §1), its CSV reader and validator.
 
+`read_flight(path)` dispatches by extension: `.ulg`, `.bin`, `.log`, `.tlog` go to
+`estimation.logs.read_log`; anything else is read as a flight CSV by `read_flight_csv`.
+
+Where a problem is
+    Every problem is a `FlightDataError` with a one-line message naming the file, the column and
+    the row, e.g. ``flight.csv: column qc_pa, row 1040 (line 1043): NaN``. *row* counts data rows
+    from 1 (the first line after the header is row 1; blank lines are not rows); *line* is the
+    line number in the file, what a person opens in an editor. Both are given because comment
+    lines before the header make them differ.
+
+What is rejected and what is dropped
+    Rejected (the whole file is unusable; a flight-test engineer must look):
+
+    - not a text CSV: empty file, binary file (a ULog or DataFlash log with a wrong extension is
+      named as such), only comments, no header (the first line holds numbers), no commas,
+      header only without data rows, fewer than `MIN_ROWS` usable rows;
+    - a missing required column (all missing ones are named, with a near-miss spelling if one
+      exists); density needs `rho_kgm3`, or both `ps_pa` and `oat_k`;
+    - time not strictly increasing: a duplicated time or a step backwards (naming the row);
+    - more than `MAX_BAD_FRACTION` (1 %) of the rows unusable (below), naming the first one:
+      that is a bad column or a bad logger, not a glitch;
+    - a unit that is wrong for the whole column, judged on medians so a few outliers cannot
+      trigger it: `q_ci` in hPa / kPa / psi / inH2O, GPS speeds in knots / km/h / cm/s (both
+      found by comparing q_ci with the GPS dynamic pressure 0.5 rho |V_g|^2, which agree
+      within the wind's effect, a factor ~0.35-4, for a flying aircraft: knots make the ratio
+      0.26, hPa 0.01), `ps_pa` in hPa or kPa, `oat_k` in degrees Celsius (< 150 K),
+      `rho_kgm3` outside 0.15-1.6 kg/m^3 (g/m^3 is named), and an aircraft that is not
+      flying (median q_ci < 20 Pa, about 11 kt, the low end of anything that flies).
+
+    Dropped with ONE warning naming the count and the first one (a few glitches in 16,000
+    samples should not stop anybody): rows where a used column is non-numeric, empty, missing
+    (short row), NaN or infinite, where `qc_pa` <= 0, or where `rho_kgm3`, `ps_pa` or `oat_k`
+    is <= 0, as long as they are at most 1 % of the rows (counted inside the time window).
+    The count is kept in `Flight.n_dropped`.
+
+    Valid as they are: gaps in time, extra columns (ignored), blank lines, `#` comment lines
+    before the header (``# key: value`` goes to `Flight.meta`), Windows line ends, a UTF-8 BOM.
+
+The input file is opened read-only and never modified. Parsing is one C-level `np.loadtxt`
+pass over the used columns (about 1 s per 10^6 rows here); only a file with non-numeric cells
+takes a slower per-column Python pass to find and name them.
+"""
+
+import difflib
+import re
+import warnings
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Flight", "write_flight_csv"]
+from .errors import FlightDataError
+from .units import density_kgm3
+
+__all__ = ["Flight", "read_flight", "read_flight_csv", "write_flight_csv"]
 
 
 @dataclass(frozen=True)
@@ -80,3 +130,450 @@ def write_flight_csv(flight, path, comments=None):
     np.savetxt(path, np.column_stack(data), delimiter=",", header=header, comments="",
                fmt=["%.4f"] + ["%.9g"] * (len(columns) - 1))
     return path
+
+
+# --- reading and validation -------------------------------------------------------------
+
+REQUIRED_COLUMNS = ("time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps")
+OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m")
+LOG_EXTENSIONS = (".ulg", ".bin", ".log", ".tlog")
+MAX_BAD_FRACTION = 0.01      # more unusable rows than this is a bad column, not a glitch
+MIN_ROWS = 10
+
+# Unit diagnosis (see the module docstring). q_ci / (0.5 rho |V_g|^2) of a flying aircraft is
+# 1 / (1 + (W/V)^2) on a full circle and at worst (1 -/+ W/V)^-2 on one leg: 0.35-4 covers
+# winds up to ~70 % of the airspeed while knots (0.26) and every pressure unit fall outside.
+_RATIO_OK = (0.35, 4.0)
+_PRESSURE_UNITS = (("Pa", 1.0), ("hPa (mbar)", 100.0), ("kPa", 1000.0), ("psi", 6894.757),
+                   ("inH2O", 249.089))
+_SPEED_UNITS = (("m/s", 1.0), ("knots", 1852.0 / 3600.0), ("km/h (or ft/s)", 1.0 / 3.6),
+                ("cm/s", 0.01))
+_QCI_MIN_FLYING_PA = 20.0    # 0.5 * 1.225 * (11 kt)^2: nothing that flies is slower
+
+
+def read_flight(path, start_s=None, end_s=None):
+    """Read a calibration flight from a flight CSV or an autopilot log.
+
+    Parameters
+    ----------
+    path : str or path-like
+        A flight CSV (INTERFACES §1) or a log: `.ulg` (PX4 ULog), `.bin`/`.log` (ArduPilot
+        DataFlash), `.tlog` (MAVLink telemetry), read by `estimation.logs.read_log`.
+    start_s, end_s : float, optional
+        Keep only samples with start_s <= time_s <= end_s, s (e.g. cut off taxi and take-off).
+        Validation (the 1 % bad-row rule) applies inside this window only.
+
+    Returns
+    -------
+    Flight
+
+    Raises
+    ------
+    FlightDataError
+        Unusable data; the one-line message names file, column and row (module docstring).
+    OSError
+        The file cannot be opened.
+
+    Examples
+    --------
+    >>> flight = read_flight("flight.csv", start_s=60.0)            # doctest: +SKIP
+    >>> flight.n, flight.meta.get("aircraft")                        # doctest: +SKIP
+    (16000, 'T-2')
+    """
+    start_s, end_s = _check_window(path, start_s, end_s)
+    if Path(path).suffix.lower() in LOG_EXTENSIONS:
+        try:
+            from .logs import read_log
+        except ModuleNotFoundError as exc:
+            if exc.name != "estimation.logs":
+                raise
+            raise FlightDataError(f"{path}: reading {Path(path).suffix} logs is not available "
+                                  "in this installation (estimation.logs missing)") from None
+        return read_log(path, start_s=start_s, end_s=end_s)
+    return read_flight_csv(path, start_s=start_s, end_s=end_s)
+
+
+def read_flight_csv(path, start_s=None, end_s=None):
+    """Read and validate a flight CSV (INTERFACES §1); see `read_flight` and the module notes.
+
+    Parameters
+    ----------
+    path : str or path-like
+    start_s, end_s : float, optional
+        Time window, s.
+
+    Returns
+    -------
+    Flight
+        SI arrays; `meta` from the ``# key: value`` lines; `n_dropped` rows dropped with a
+        warning; `source` is `path` as given.
+    """
+    start_s, end_s = _check_window(path, start_s, end_s)
+    name = str(path)
+    _reject_binary(path, name)
+    header_line, columns, meta = _read_header(path, name)
+    use = _used_columns(name, columns)
+    table = _parse_body(path, name, header_line, columns, use)
+    if table.data.shape[0] == 0:
+        raise FlightDataError(f"{name}: header only, no data rows after line {header_line}")
+
+    col = {c: j for j, c in enumerate(use)}
+    data, rows = _window(name, table, col["time_s"], start_s, end_s)
+    data, rows, n_dropped = _drop_bad_rows(name, table, data, rows, use)
+    time_s = data[:, col["time_s"]]
+    _check_time(name, table, time_s, rows)
+    if time_s.size < MIN_ROWS:
+        raise FlightDataError(f"{name}: only {time_s.size} usable data rows, at least {MIN_ROWS} "
+                              "needed")
+
+    qci = data[:, col["qc_pa"]]
+    vn, ve = data[:, col["gps_vn_mps"]], data[:, col["gps_ve_mps"]]
+    if "rho_kgm3" in col:
+        rho = data[:, col["rho_kgm3"]]
+        _check_rho(name, rho)
+    else:
+        ps, oat = data[:, col["ps_pa"]], data[:, col["oat_k"]]
+        _check_ps_oat(name, ps, oat)
+        rho = density_kgm3(ps, oat)
+    _check_units(name, qci, vn, ve, rho)
+    optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
+                for c in OPTIONAL_COLUMNS}
+    return Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
+                  gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
+                  rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
+                  n_dropped=n_dropped, **optional)
+
+
+class _Table:
+    """The parsed body: `data` (rows x used columns) plus what is needed to name a row."""
+
+    def __init__(self, path, header_line, data, bad=None, lines=None):
+        self.path = path
+        self.header_line = header_line
+        self.data = data
+        self.bad = bad or {}          # parsed row index -> (column, problem) for unparsable cells
+        self._lines = lines           # parsed row index -> file line; None: computed on demand
+
+    def where(self, r):
+        """'row R (line L)' of parsed row index `r` (0-based)."""
+        if self._lines is None:
+            self._lines = _data_line_numbers(self.path, self.header_line)
+        line = self._lines[r] if r < len(self._lines) else self.header_line + 1 + r
+        return f"row {r + 1} (line {line})"
+
+
+def _check_window(path, start_s, end_s):
+    bounds = []
+    for label, value in (("start_s", start_s), ("end_s", end_s)):
+        if value is not None:
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise FlightDataError(f"{path}: {label}={value!r} is not a number") from None
+            if not np.isfinite(value):
+                raise FlightDataError(f"{path}: {label}={value} is not finite")
+        bounds.append(value)
+    if None not in bounds and bounds[0] >= bounds[1]:
+        raise FlightDataError(f"{path}: start_s={bounds[0]:g} must be before end_s={bounds[1]:g}")
+    return bounds
+
+
+def _reject_binary(path, name):
+    with open(path, "rb") as f:            # read-only: the input is never modified
+        head = f.read(65536)
+    if not head.strip():
+        raise FlightDataError(f"{name}: empty file, not a flight CSV")
+    if b"\0" in head:
+        kind = "binary file"
+        if head.startswith(b"ULog"):
+            kind = "PX4 ULog file (name it .ulg to read it as a log)"
+        elif head[:2] == b"\xa3\x95":
+            kind = "ArduPilot DataFlash log (name it .bin to read it as a log)"
+        raise FlightDataError(f"{name}: {kind}, not a flight CSV")
+
+
+def _text(path):
+    # utf-8-sig drops a BOM; undecodable bytes become U+FFFD and then fail as non-numeric
+    # cells or unknown column names, with a row to point at, rather than a decode error.
+    return open(path, "r", encoding="utf-8-sig", errors="replace", newline=None)
+
+
+def _read_header(path, name):
+    """(header line number, column names, meta) from the lines before the data."""
+    meta = {}
+    with _text(path) as f:
+        for line_no, line in enumerate(f, start=1):
+            text = line.strip()
+            if not text:
+                continue
+            if text.startswith("#"):
+                key, sep, value = text[1:].partition(":")
+                if sep and key.strip():
+                    meta[key.strip()] = value.strip()
+                continue
+            break
+        else:
+            raise FlightDataError(f"{name}: only comment lines, no header row and no data")
+    columns = [c.strip().strip('"').strip("'").strip() for c in text.split(",")]
+    if len(columns) == 1:
+        for sep, label in ((";", "semicolons"), ("\t", "tabs")):
+            if sep in text:
+                raise FlightDataError(f"{name}: line {line_no}: fields are separated by {label}; "
+                                      "a flight CSV uses commas")
+        raise FlightDataError(f"{name}: line {line_no}: not a CSV header (no commas); expected "
+                              f"columns {', '.join(REQUIRED_COLUMNS)}, ...")
+    if all(_is_number(c) for c in columns if c):
+        raise FlightDataError(f"{name}: line {line_no}: no header row (the first line holds "
+                              f"numbers); expected column names {', '.join(REQUIRED_COLUMNS)}, ...")
+    if not set(columns) & set(REQUIRED_COLUMNS) and not all(map(_NAME.match, columns)):
+        raise FlightDataError(f"{name}: line {line_no}: not a CSV header; expected columns "
+                              f"{', '.join(REQUIRED_COLUMNS)}, ...")
+    return line_no, columns, meta
+
+
+_NAME = re.compile(r"^[A-Za-z_][\w .()/%\[\]-]*$")
+
+
+def _is_number(text):
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _used_columns(name, columns):
+    """Names of the columns read, in order: required, density, optional present."""
+    present = set(columns)
+    missing = [c for c in REQUIRED_COLUMNS if c not in present]
+    if missing:
+        hints = []
+        for c in missing:
+            close = difflib.get_close_matches(c, columns, n=1, cutoff=0.6)
+            close = close or [x for x in columns if x.lower() == c.lower()]
+            if close:
+                hints.append(f"{c} (found {close[0]!r})")
+            else:
+                hints.append(c)
+        raise FlightDataError(f"{name}: missing column{'s' if len(missing) > 1 else ''} "
+                              f"{', '.join(hints)}; required: {', '.join(REQUIRED_COLUMNS)} "
+                              "and density (rho_kgm3, or both ps_pa and oat_k)")
+    if "rho_kgm3" in present:
+        density = ["rho_kgm3"]
+    elif "ps_pa" in present and "oat_k" in present:
+        density = ["ps_pa", "oat_k"]
+    else:
+        found = [c for c in ("ps_pa", "oat_k") if c in present]
+        also = f" (found only {found[0]})" if found else ""
+        raise FlightDataError(f"{name}: missing column for density: needs rho_kgm3, or both "
+                              f"ps_pa and oat_k{also}")
+    use = list(REQUIRED_COLUMNS) + density + [c for c in OPTIONAL_COLUMNS if c in present]
+    for c in use:
+        if columns.count(c) > 1:
+            raise FlightDataError(f"{name}: column {c} appears {columns.count(c)} times in the "
+                                  "header")
+    return use
+
+
+def _parse_body(path, name, header_line, columns, use):
+    """Parse the used columns; fast C path, or a slower pass that names unparsable cells."""
+    index = [columns.index(c) for c in use]
+    with _text(path) as f:
+        for _ in range(header_line):
+            f.readline()
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")      # "input contained no data": we say it better
+                data = np.loadtxt(f, delimiter=",", usecols=index, ndmin=2, comments=None,
+                                  dtype=float)
+            return _Table(path, header_line, data.reshape(-1, len(use)))
+        except ValueError:
+            pass
+    return _parse_slow(path, header_line, columns, use, index)
+
+
+def _parse_slow(path, header_line, columns, use, index):
+    with _text(path) as f:
+        lines = f.read().splitlines()[header_line:]
+    line_no, fields = [], []
+    for k, line in enumerate(lines):
+        # blank lines are skipped as np.loadtxt does; a '#' line inside the data is a bad row
+        if line.strip():
+            line_no.append(header_line + 1 + k)
+            fields.append(line.split(","))
+    n, width = len(fields), len(columns)
+    data = np.full((n, len(use)), np.nan)
+    bad = {}
+    for j, (c, i) in enumerate(zip(use, index)):
+        cells = [f[i] if i < len(f) else None for f in fields]
+        try:
+            data[:, j] = np.array(cells, dtype=float) if None not in cells else 1 / 0
+            continue
+        except (ValueError, TypeError, ZeroDivisionError):
+            pass
+        for r, cell in enumerate(cells):
+            if cell is None:
+                problem = f"short row ({len(fields[r])} fields, header has {width})"
+            else:
+                try:
+                    data[r, j] = float(cell)
+                    continue
+                except ValueError:
+                    problem = "empty cell" if not cell.strip() else \
+                        f"non-numeric value {cell.strip()[:20]!r}"
+            bad.setdefault(r, (c, problem))
+    return _Table(path, header_line, data, bad, np.array(line_no))
+
+
+def _data_line_numbers(path, header_line):
+    """File line number of each data row (blank lines are not rows)."""
+    with _text(path) as f:
+        lines = f.read().splitlines()[header_line:]
+    return np.array([header_line + 1 + k for k, line in enumerate(lines) if line.strip()])
+
+
+def _window(name, table, jt, start_s, end_s):
+    """Rows (and their parsed indices) from the first to the last inside the time window."""
+    data = table.data
+    rows = np.arange(data.shape[0])
+    if start_s is None and end_s is None:
+        return data, rows
+    t = data[:, jt]
+    lo = -np.inf if start_s is None else start_s
+    hi = np.inf if end_s is None else end_s
+    inside = np.flatnonzero(np.isfinite(t) & (t >= lo) & (t <= hi))
+    if inside.size == 0:
+        finite = t[np.isfinite(t)]
+        span = f"{finite.min():g} to {finite.max():g} s" if finite.size else "no valid times"
+        raise FlightDataError(f"{name}: column time_s: no rows between start_s={start_s} and "
+                              f"end_s={end_s} (the file spans {span})")
+    # the positional range keeps NaN-time rows between in-window rows, so they are counted
+    sl = slice(inside[0], inside[-1] + 1)
+    return data[sl], rows[sl]
+
+
+def _row_problem(table, data_row, r, use):
+    """(column, problem) of a row, or None if it is usable."""
+    if r in table.bad:
+        return table.bad[r]
+    for c, v in zip(use, data_row):
+        if np.isnan(v):
+            return c, "NaN"
+        if np.isinf(v):
+            return c, f"{'-' if v < 0 else ''}infinite"
+        if c == "qc_pa" and v <= 0:
+            return c, f"q_ci = {v:g} Pa is not positive"
+        if c in ("rho_kgm3", "ps_pa", "oat_k") and v <= 0:
+            return c, f"{v:g} is not positive"
+    return None
+
+
+def _drop_bad_rows(name, table, data, rows, use):
+    col = {c: j for j, c in enumerate(use)}
+    bad = ~np.isfinite(data).all(axis=1)
+    bad |= data[:, col["qc_pa"]] <= 0
+    for c in ("rho_kgm3", "ps_pa", "oat_k"):
+        if c in col:
+            bad |= data[:, col[c]] <= 0
+    if table.bad:
+        bad |= np.isin(rows, np.fromiter(table.bad, dtype=int))
+    n_bad, n = int(bad.sum()), data.shape[0]
+    if n_bad == 0:
+        return data, rows, 0
+    first = int(np.flatnonzero(bad)[0])
+    c, problem = _row_problem(table, data[first], rows[first], use)
+    where = f"column {c}, {table.where(rows[first])}: {problem}"
+    if n_bad > MAX_BAD_FRACTION * n:
+        whole = _whole_column_bad(table, data, rows, use)
+        if whole:
+            raise FlightDataError(f"{name}: column {whole}: no usable value in any row (first: "
+                                  f"{table.where(rows[first])}: {problem})")
+        raise FlightDataError(f"{name}: {where} ({n_bad} of {n} rows unusable, more than "
+                              f"{MAX_BAD_FRACTION:.0%}; fix them or cut them out with "
+                              "start_s/end_s)")
+    warnings.warn(f"{name}: dropped {n_bad} of {n} rows with unusable values (first: {where})",
+                  stacklevel=4)
+    keep = ~bad
+    return data[keep], rows[keep], n_bad
+
+
+def _whole_column_bad(table, data, rows, use):
+    for j, c in enumerate(use):
+        v = data[:, j]
+        ok = np.isfinite(v) & ((v > 0) if c in ("qc_pa", "rho_kgm3", "ps_pa", "oat_k") else True)
+        ok &= ~np.isin(rows, [r for r, (cc, _) in table.bad.items() if cc == c])
+        if not ok.any():
+            return c
+    return None
+
+
+def _check_time(name, table, t, rows):
+    step = np.diff(t)
+    back = np.flatnonzero(step <= 0)
+    if back.size:
+        k = int(back[0]) + 1
+        how = "duplicates" if step[k - 1] == 0 else "is before"
+        raise FlightDataError(f"{name}: column time_s, {table.where(rows[k])}: time {t[k]:.6g} s "
+                              f"{how} the previous row's {t[k - 1]:.6g} s; time must be strictly "
+                              "increasing")
+
+
+def _check_rho(name, rho):
+    med = float(np.median(rho))
+    if 0.15 <= med <= 1.6:
+        return
+    unit = " (looks like g/m^3)" if 150 <= med <= 1600 else ""
+    raise FlightDataError(f"{name}: column rho_kgm3: median {med:.4g} is not an air density in "
+                          f"kg/m^3 (0.15-1.6){unit}")
+
+
+def _check_ps_oat(name, ps, oat):
+    med = float(np.median(ps))
+    if not 5e3 <= med <= 1.2e5:
+        unit = next((u for u, lo, hi in (("hPa (mbar)", 150, 1200), ("kPa", 5, 120),
+                                         ("psi", 0.7, 17), ("inHg", 1.5, 35.4)) if lo <= med <= hi),
+                    None)
+        looks = f"looks like {unit}" if unit else "is not a static pressure"
+        raise FlightDataError(f"{name}: column ps_pa: median {med:.5g} {looks}; expected Pa "
+                              "(about 101325 at sea level)")
+    med = float(np.median(oat))
+    if med < 150:
+        raise FlightDataError(f"{name}: column oat_k: median {med:.4g} looks like degrees Celsius; "
+                              "expected kelvin (K = degC + 273.15)")
+    if med > 400:
+        raise FlightDataError(f"{name}: column oat_k: median {med:.4g} K is not an air temperature "
+                              "(expected 180-330 K)")
+
+
+def _check_units(name, qci, vn, ve, rho):
+    """Catch q_ci and GPS speeds in the wrong unit by comparing them with each other."""
+    q_med = float(np.median(qci))
+    q_gps = float(np.median(0.5 * rho * (vn ** 2 + ve ** 2)))
+    gs_med = float(np.median(np.hypot(vn, ve)))
+    ratio = q_med / q_gps if q_gps > 0 else np.inf
+    if _RATIO_OK[0] <= ratio <= _RATIO_OK[1]:
+        if q_med < _QCI_MIN_FLYING_PA:
+            raise FlightDataError(
+                f"{name}: column qc_pa: median q_ci {q_med:.3g} Pa and ground speed "
+                f"{gs_med:.3g} m/s: the aircraft is not flying; select the flight with "
+                "start_s/end_s")
+        return
+    # the unit pair that makes q_ci and the GPS dynamic pressure agree best
+    best = min(((abs(np.log(ratio * a / b ** 2)) if np.isfinite(ratio) else np.inf, pu, su)
+                for pu, a in _PRESSURE_UNITS for su, b in _SPEED_UNITS),
+               key=lambda x: x[0])
+    misfit, p_unit, s_unit = best
+    implied = np.sqrt(2.0 * q_med / float(np.median(rho)))
+    if misfit < np.log(2.0) and (p_unit, s_unit) != ("Pa", "m/s"):
+        parts = []
+        if p_unit != "Pa":
+            parts.append(f"column qc_pa: median {q_med:.4g} looks like {p_unit}, expected Pa")
+        if s_unit != "m/s":
+            parts.append(f"columns gps_vn_mps/gps_ve_mps: median ground speed {gs_med:.4g} looks "
+                         f"like {s_unit}, expected m/s")
+        raise FlightDataError(f"{name}: {'; '.join(parts)} (q_ci / (0.5 rho Vg^2) = "
+                              f"{ratio:.3g}, should be near 1)")
+    raise FlightDataError(
+        f"{name}: columns qc_pa and gps_vn_mps/gps_ve_mps disagree: median q_ci {q_med:.4g} Pa "
+        f"implies {implied:.3g} m/s true airspeed but the median ground speed is {gs_med:.3g} "
+        "m/s; check their units")
