@@ -1,0 +1,140 @@
+"""Sensor models of the simulator: the pitot-static chain and the GPS velocity, on whole arrays.
+
+Impact pressure, in the order the air and the signal meet them: the pressure-error model at the
+probe (estimation.models, paper eq. 1 and 4), the first-order pneumatic lag of the tubing, the
+transducer's scale error, bias and white noise, then the converter's quantization.
+GPS velocity: the receiver measures the velocity `latency` seconds old, adds white noise, and
+reports it at its own rate; the logger holds the last report until the next (sample-and-hold).
+"""
+
+import numpy as np
+
+from estimation.errors import PitotcalError
+from estimation.models import get_model, qci_from_qc_pa
+
+__all__ = ["first_order_lag", "impact_pressure_sensor", "gps_velocity_sensor", "hold_index"]
+
+
+def first_order_lag(x, dt_s, tau_s):
+    """First-order lag tau y' + y = x, discretised exactly for a zero-order-held input.
+
+    Starts in equilibrium with the first sample (the probe was settled before the record).
+
+    Parameters
+    ----------
+    x : ndarray (N,)
+    dt_s : float
+        Sample step, s.
+    tau_s : float
+        Time constant, s (0: no lag, `x` is returned).
+    """
+    from scipy.signal import lfilter
+
+    x = np.asarray(x, dtype=float)
+    if tau_s <= 0 or x.size == 0:
+        return x.copy()
+    a = np.exp(-dt_s / tau_s)
+    y, _ = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])
+    return y
+
+
+def impact_pressure_sensor(qc_pa, dt_s, rng, *, model="inverse", k=(0.02, -15.0),
+                           pneumatic_lag_s=0.0, scale_error=0.0, bias_pa=0.0, noise_pa=0.0,
+                           quantization_pa=0.0):
+    """What a differential-pressure transducer on the pitot-static system records.
+
+    Parameters
+    ----------
+    qc_pa : ndarray (N,)
+        True impact pressure q_c, Pa, sampled every `dt_s` seconds.
+    dt_s : float
+        Sample step, s.
+    rng : numpy.random.Generator
+        Source of the transducer noise.
+    model : str
+        Pressure-error structure (estimation.models.MODELS).
+    k : sequence of float
+        Its coefficients (the first as many as the model has are used).
+    pneumatic_lag_s : float
+        Time constant of the tubing lag, s.
+    scale_error : float
+        Relative gain error of the transducer (0.01: reads 1 % high).
+    bias_pa, noise_pa, quantization_pa : float
+        Zero offset, white-noise standard deviation and converter step, Pa.
+
+    Returns
+    -------
+    ndarray (N,)
+        Recorded q_ci, Pa.
+
+    Notes
+    -----
+    q_ci solves q_ci = q_c (1 - f(q_ci; k)) (paper eq. 1 with eq. 4), then
+    recorded = Q[(1 + scale_error) lag(q_ci) + bias + noise], Q rounding to the step.
+    """
+    m = get_model(model)
+    if len(k) < len(m.params):
+        raise PitotcalError(f"k needs {len(m.params)} coefficients for model {model!r}, got {len(k)}")
+    for name, value in (("pneumatic_lag_s", pneumatic_lag_s), ("noise_pa", noise_pa),
+                        ("quantization_pa", quantization_pa)):
+        if not np.isfinite(value) or value < 0:
+            raise PitotcalError(f"{name} must be finite and >= 0, got {value}")
+    qci = qci_from_qc_pa(m, tuple(k[:len(m.params)]), qc_pa)
+    qci = first_order_lag(qci, dt_s, pneumatic_lag_s)
+    qci = (1.0 + scale_error) * qci + bias_pa + rng.standard_normal(qci.size) * noise_pa
+    if quantization_pa > 0:
+        qci = np.round(qci / quantization_pa) * quantization_pa
+    return qci
+
+
+def hold_index(time_s, rate_hz):
+    """Index of the latest sample at or before each update tick of a `rate_hz` device.
+
+    With `rate_hz` None or 0, or not below the sample rate, every sample is its own update.
+    """
+    t = np.asarray(time_s, dtype=float)
+    if not rate_hz:
+        return np.arange(t.size)
+    period = 1.0 / rate_hz
+    tick = np.floor((t - t[0]) / period + 1e-9) * period + t[0]
+    return np.searchsorted(t, tick - 1e-9)
+
+
+def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, latency_s=0.0):
+    """GPS velocity as logged: delayed, noisy, updated at `rate_hz` and held in between.
+
+    Parameters
+    ----------
+    time_s : ndarray (N,)
+        Sample times, s (uniform step).
+    vel_mps : ndarray (N, C)
+        True ground velocity components (north, east, down), m/s.
+    rng : numpy.random.Generator
+        Source of the noise: one independent draw per component and GPS update.
+    rate_hz : float or None
+        GPS update rate, Hz (None or 0: every sample).
+    noise_mps : float
+        White-noise standard deviation per component and update, m/s.
+    latency_s : float
+        Age of the reported velocity, s (>= 0); before the record starts the first value is used.
+
+    Returns
+    -------
+    ndarray (N, C)
+    """
+    t = np.asarray(time_s, dtype=float)
+    vel = np.asarray(vel_mps, dtype=float).reshape(t.size, -1)
+    if rate_hz is not None and (not np.isfinite(rate_hz) or rate_hz < 0):
+        raise PitotcalError(f"gps_rate_hz must be >= 0, got {rate_hz}")
+    if not np.isfinite(noise_mps) or noise_mps < 0:
+        raise PitotcalError(f"gps_noise_mps must be >= 0, got {noise_mps}")
+    if not np.isfinite(latency_s) or latency_s < 0:
+        raise PitotcalError(f"gps_latency_s must be >= 0, got {latency_s}")
+    if latency_s > 0:
+        # np.interp holds the first value for times before the record: the receiver's first fix.
+        vel = np.column_stack([np.interp(t - latency_s, t, vel[:, j]) for j in range(vel.shape[1])])
+    held = hold_index(t, rate_hz)
+    # One noise draw per sample, read through the hold: each update carries its own draw and
+    # the result does not depend on how many updates there are before a given sample.
+    noise = rng.standard_normal(vel.shape) * noise_mps
+    return vel[held] + noise[held]

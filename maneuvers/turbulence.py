@@ -1,0 +1,163 @@
+"""Dryden turbulence: MIL-F-8785C shaping filters built with python-control, run on whole arrays.
+
+The gust field is frozen and the aircraft flies through it at the mean true airspeed V, so a
+spatial spectrum with scale L becomes a temporal one with time constant L / V. Unit-intensity
+white noise through the shaping filters gives the gust components along the flight path (u),
+across it (v, to the right) and vertical (w, down).
+
+Notes
+-----
+MIL-F-8785C (also MIL-HDBK-1797 Appendix, "Dryden form"), with V in m/s and L in m::
+
+    H_u(s) = sigma_u sqrt(2 L_u / (pi V)) / (1 + (L_u/V) s)
+    H_v(s) = sigma_v sqrt(L_v / (pi V)) (1 + sqrt(3) (L_v/V) s) / (1 + (L_v/V) s)^2
+    H_w(s) = sigma_w sqrt(L_w / (pi V)) (1 + sqrt(3) (L_w/V) s) / (1 + (L_w/V) s)^2
+
+driven by white noise of two-sided spectral density pi (so the output variance is sigma^2);
+in discrete time at step dt that is unit Gaussian samples times sqrt(pi / dt). Autocorrelation
+in distance xi: R_u = sigma_u^2 exp(-xi/L_u), R_v = sigma_v^2 (1 - xi/(2 L_v)) exp(-xi/L_v).
+
+Low-altitude scales (h in feet, 10 ft <= h <= 1000 ft)::
+
+    L_w = h,   L_u = L_v = h / (0.177 + 0.000823 h)^1.2,
+    sigma_u / sigma_w = sigma_v / sigma_w = 1 / (0.177 + 0.000823 h)^0.4
+
+Above 2000 ft the turbulence is isotropic with L = 1750 ft; in between, the scales and the
+intensity ratio are interpolated linearly in altitude (as the MATLAB/Simulink Dryden block does).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from estimation.errors import PitotcalError
+from estimation.units import FT_TO_M
+
+__all__ = ["DrydenScales", "dryden_scales", "dryden_filters", "dryden_gusts"]
+
+_LOW_FT, _HIGH_FT = 1000.0, 2000.0
+_HIGH_SCALE_FT = 1750.0
+
+
+@dataclass(frozen=True)
+class DrydenScales:
+    """Intensities (m/s, one standard deviation) and scale lengths (m) of the three gust axes."""
+
+    sigma_u_mps: float
+    sigma_v_mps: float
+    sigma_w_mps: float
+    length_u_m: float
+    length_v_m: float
+    length_w_m: float
+
+
+def _low_altitude(h_ft):
+    h = float(np.clip(h_ft, 10.0, _LOW_FT))
+    base = 0.177 + 0.000823 * h
+    return h / base ** 1.2, h, 1.0 / base ** 0.4          # L_uv, L_w (ft), sigma_uv / sigma_w
+
+
+def dryden_scales(alt_m, sigma_horizontal_mps, length_m=None):
+    """MIL-F-8785C scales at an altitude for a given horizontal intensity.
+
+    Parameters
+    ----------
+    alt_m : float
+        Height above ground, m (>= 0).
+    sigma_horizontal_mps : float
+        RMS of the horizontal gust components sigma_u = sigma_v, m/s (>= 0).
+    length_m : float, optional
+        Override of the horizontal scale length L_u = L_v, m (> 0).
+
+    Returns
+    -------
+    DrydenScales
+    """
+    if not np.isfinite(alt_m) or alt_m < 0:
+        raise PitotcalError(f"alt_m must be finite and >= 0, got {alt_m}")
+    if not np.isfinite(sigma_horizontal_mps) or sigma_horizontal_mps < 0:
+        raise PitotcalError(f"turbulence intensity must be >= 0 m/s, got {sigma_horizontal_mps}")
+    if length_m is not None and (not np.isfinite(length_m) or length_m <= 0):
+        raise PitotcalError(f"turbulence length must be > 0 m, got {length_m}")
+    h_ft = alt_m / FT_TO_M
+    l_uv, l_w, ratio = _low_altitude(h_ft)
+    if h_ft > _LOW_FT:
+        # Blend to the isotropic medium/high-altitude model between 1000 and 2000 ft.
+        f = min((h_ft - _LOW_FT) / (_HIGH_FT - _LOW_FT), 1.0)
+        l_uv = l_uv + f * (_HIGH_SCALE_FT - l_uv)
+        l_w = l_w + f * (_HIGH_SCALE_FT - l_w)
+        ratio = ratio + f * (1.0 - ratio)
+    l_uv_m = l_uv * FT_TO_M if length_m is None else float(length_m)
+    sigma = float(sigma_horizontal_mps)
+    return DrydenScales(sigma, sigma, sigma / ratio, l_uv_m, l_uv_m, l_w * FT_TO_M)
+
+
+def dryden_filters(scales, tas_mps):
+    """Continuous shaping filters (u, v, w) as python-control transfer functions.
+
+    Parameters
+    ----------
+    scales : DrydenScales
+    tas_mps : float
+        Mean true airspeed through the frozen field, m/s (> 0).
+
+    Returns
+    -------
+    tuple of control.TransferFunction
+        H_u, H_v, H_w of the module Notes (input: white noise of spectral density pi).
+    """
+    import control
+
+    if not np.isfinite(tas_mps) or tas_mps <= 0:
+        raise PitotcalError(f"tas_mps must be > 0, got {tas_mps}")
+    v = float(tas_mps)
+    t_u, t_v, t_w = scales.length_u_m / v, scales.length_v_m / v, scales.length_w_m / v
+    h_u = control.tf([scales.sigma_u_mps * np.sqrt(2.0 * t_u / np.pi)], [t_u, 1.0])
+
+    def lateral(sigma, tau):
+        gain = sigma * np.sqrt(tau / np.pi)
+        return control.tf([gain * np.sqrt(3.0) * tau, gain], [tau * tau, 2.0 * tau, 1.0])
+
+    return h_u, lateral(scales.sigma_v_mps, t_v), lateral(scales.sigma_w_mps, t_w)
+
+
+def dryden_gusts(n, dt_s, scales, tas_mps, rng):
+    """Gust time series (u, v, w) of `n` samples at step `dt_s`, stationary from the first sample.
+
+    Each filter is discretised with a zero-order hold (python-control `c2d`) and run over the
+    whole noise array with `scipy.signal.lfilter`; a burn-in of ten time constants is discarded
+    so the series starts in the stationary distribution rather than at zero.
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+    dt_s : float
+        Sample step, s.
+    scales : DrydenScales
+    tas_mps : float
+        Mean true airspeed, m/s.
+    rng : numpy.random.Generator
+        Source of the white noise (the only randomness used).
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Columns u (along the path), v (to the right), w (down), m/s.
+    """
+    from scipy.signal import lfilter
+    import control
+
+    if n < 1 or dt_s <= 0:
+        raise PitotcalError(f"need n >= 1 and dt_s > 0, got n={n}, dt_s={dt_s}")
+    filters = dryden_filters(scales, tas_mps)
+    tau = max(scales.length_u_m, scales.length_v_m, scales.length_w_m) / tas_mps
+    burn = int(np.ceil(10.0 * tau / dt_s))
+    noise = rng.standard_normal((3, burn + n)) * np.sqrt(np.pi / dt_s)
+    out = np.empty((n, 3))
+    for j, h in enumerate(filters):
+        hd = control.c2d(h, dt_s, method="zoh")
+        num = np.atleast_1d(np.squeeze(hd.num[0][0]))
+        den = np.atleast_1d(np.squeeze(hd.den[0][0]))
+        out[:, j] = lfilter(num, den, noise[j])[burn:]
+    return out
