@@ -1,0 +1,222 @@
+"""ArduPilot DataFlash reader (binary `.bin` and text `.log`): the raw streams, for `estimation.logs`.
+
+pymavlink's ``mavutil.mavlink_connection`` reads both forms. Messages read, with the field
+names of older (3.x) and newer (4.x) firmware:
+
+- ``ARSP`` (first sensor; instance ``I == 0`` where the field exists): ``DiffPress`` (Pa).
+  A log with ``Airspeed`` but no ``DiffPress`` is converted with ArduPilot's own relation
+  EAS = sqrt(ARSPD_RATIO · Δp), i.e. q_ci = EAS² / ARSPD_RATIO, with a warning.
+- ``BARO`` (instance 0): ``Press`` (Pa) and ``Temp`` (°C).
+- temperature: ``ARSP.Temp`` (the airspeed sensor's, usually nearer the outside air) when the
+  sensor reports one (not identically 0), else ``BARO.Temp``. ArduPilot logs no outside air
+  temperature: both are sensor temperatures, and the reader warns so.
+- ``GPS`` (instance 0; not GPS2/GPSB): ``Status >= 3`` (3D fix) is valid; velocity from
+  ``VelN/VelE`` where present, else ``Spd`` and ``GCrs`` (course over ground, deg true);
+  ``VZ`` is the down velocity (NED, positive down). Altitude ``Alt`` (m MSL).
+- the EKF wind estimate for comparison: ``XKF2`` (EKF3) or ``NKF2`` (EKF2), core ``C == 0``,
+  else the old EKF's ``EKF2``; ``VWN, VWE`` are the air-mass velocity (the way it blows TO).
+- parameters: ARSPD_RATIO (and ARSPD_ENABLE / ARSPD_TYPE to explain a log without airspeed).
+
+Times: ``TimeUS`` (µs since boot); old messages ``TimeMS`` (ms); old ``GPS`` messages keep the
+GPS week time in ``TimeMS`` and the boot time in ``T`` (ms), which is used. The log's zero is
+the time-stamp of the first data message in it.
+"""
+
+import contextlib
+import io
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .errors import FlightDataError
+
+_TYPES = ("ARSP", "BARO", "GPS", "XKF2", "NKF2", "EKF2", "MSG", "VER")
+_HEADER_TYPES = {"FMT", "FMTU", "UNIT", "MULT", "PARM"}
+_FIRMWARE = re.compile(r"^(Ardu\w+|Rover|APM:\w+|ArduPilot)\s+V?\d", re.IGNORECASE)
+
+
+def _time_field(fields, msg_type):
+    if "TimeUS" in fields:
+        return "TimeUS", 1e-6
+    if msg_type == "GPS" and "T" in fields:
+        return "T", 1e-3          # old GPS: TimeMS is GPS time of week
+    if "TimeMS" in fields:
+        return "TimeMS", 1e-3
+    return None, None
+
+
+class _Collector:
+    """Columns of the wanted fields of one message type, in log order."""
+
+    def __init__(self, msg, wanted):
+        fields = msg.get_fieldnames()
+        self.time_name, self.time_scale = _time_field(fields, msg.get_type())
+        self.names = [f for f in wanted if f in fields]
+        self.rows = []
+
+    def add(self, msg):
+        self.rows.append([getattr(msg, self.time_name, np.nan) if self.time_name else np.nan]
+                         + [getattr(msg, f, np.nan) for f in self.names])
+
+    def columns(self):
+        a = np.asarray(self.rows, dtype=float).reshape(-1, 1 + len(self.names))
+        out = {name: a[:, i + 1] for i, name in enumerate(self.names)}
+        out["t"] = a[:, 0] * (self.time_scale or np.nan)
+        return out
+
+
+_WANTED = {
+    "ARSP": ("I", "Airspeed", "DiffPress", "Temp", "Health", "H"),
+    "BARO": ("I", "Press", "Temp", "Health", "H"),
+    "GPS": ("I", "Status", "Spd", "GCrs", "VZ", "VelN", "VelE", "VelD", "Alt"),
+    "XKF2": ("C", "VWN", "VWE"),
+    "NKF2": ("C", "VWN", "VWE"),
+    "EKF2": ("VWN", "VWE"),
+}
+
+
+def _scan(path):
+    """Read the wanted messages: ({type: columns}, params, firmware, log start, n_messages)."""
+    from pymavlink import mavutil
+
+    name = Path(path).name
+    collectors, firmware, n_data, t_first = {}, None, 0, np.inf
+    # pymavlink prints "bad header" / "Skipped N bad bytes" on stdout: catch it, report it once.
+    chatter = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(chatter):
+            log = mavutil.mavlink_connection(str(path), dialect="ardupilotmega")
+            if type(log).__name__ not in ("DFReader_binary", "DFReader_text"):
+                raise FlightDataError(f"{name}: not an ArduPilot DataFlash log "
+                                      f"(pymavlink reads it as {type(log).__name__})")
+            while True:
+                msg = log.recv_msg()
+                if msg is None:
+                    break
+                mtype = msg.get_type()
+                if mtype not in _HEADER_TYPES:
+                    n_data += 1
+                    if not np.isfinite(t_first):
+                        # The log's zero: the first data message's own time-stamp (in file
+                        # order, not the minimum: a stray tiny stamp must not shift it).
+                        t = getattr(msg, "TimeUS", None)
+                        if t:
+                            t_first = t * 1e-6
+                        elif mtype != "GPS" and getattr(msg, "TimeMS", None):
+                            t_first = msg.TimeMS * 1e-3
+                if mtype == "MSG" and firmware is None and _FIRMWARE.match(msg.Message or ""):
+                    firmware = msg.Message.strip()
+                elif mtype == "VER" and firmware is None and hasattr(msg, "FWS"):
+                    firmware = str(msg.FWS).strip() or None
+                elif mtype in _WANTED:
+                    if mtype not in collectors:
+                        collectors[mtype] = _Collector(msg, _WANTED[mtype])
+                    collectors[mtype].add(msg)
+            params = dict(getattr(log, "params", {}) or {})
+    except FlightDataError:
+        raise
+    except (ValueError, OSError, IndexError, KeyError, TypeError, UnicodeDecodeError,
+            AttributeError) as exc:
+        # pymavlink fails on empty / mangled files with assorted low-level errors.
+        raise FlightDataError(f"{name}: not a readable DataFlash log ({exc}); "
+                              "truncated or corrupt?") from None
+    skipped = re.findall(r"Skipped (\d+) bad bytes", chatter.getvalue())
+    if skipped and n_data:
+        warnings.warn(f"{name}: skipped {sum(map(int, skipped))} corrupt bytes in the log",
+                      stacklevel=4)
+    if n_data == 0:
+        raise FlightDataError(f"{name}: no data messages in the log (only format headers); "
+                              "truncated or corrupt file?")
+    data = {k: c.columns() for k, c in collectors.items()}
+    return data, params, firmware, (0.0 if not np.isfinite(t_first) else t_first), n_data
+
+
+def _instance0(cols, key="I"):
+    if key in cols and cols[key].size:
+        first = np.nanmin(cols[key])
+        keep = cols[key] == first
+        return {k: v[keep] for k, v in cols.items()}
+    return cols
+
+
+def _no_airspeed_message(name, params):
+    said = [f"{p}={params[p]:g}" for p in ("ARSPD_ENABLE", "ARSPD_TYPE", "ARSPD_USE")
+            if p in params]
+    return (f"{name}: no airspeed data (ARSP) in the log"
+            + (f"; {', '.join(said[:1])}" if said else ""))
+
+
+def read_dataflash_streams(path):
+    """Read the streams of an ArduPilot DataFlash `.bin` / `.log` into a `LogStreams`."""
+    from .logs import LogStreams
+
+    name = Path(path).name
+    data, params, firmware, t0, _ = _scan(path)
+    fmt = "binary" if Path(path).suffix.lower() == ".bin" else "text"
+    s = LogStreams(log_format=f"ArduPilot DataFlash {fmt}")
+    s.autopilot = firmware or "ArduPilot (firmware version not logged)"
+
+    arsp = data.get("ARSP")
+    if arsp is None or arsp["t"].size == 0:
+        raise FlightDataError(_no_airspeed_message(name, params))
+    arsp = _instance0(arsp)
+    s.pressure_t = arsp["t"] - t0
+    ratio = params.get("ARSPD_RATIO")
+    if ratio is not None:
+        s.airspeed_scale["ARSPD_RATIO"] = float(ratio)
+    if "DiffPress" in arsp:
+        s.qci_pa = arsp["DiffPress"]
+        s.pressure_source = "ARSP.DiffPress (Pa)"
+    elif "Airspeed" in arsp:
+        if not ratio or ratio <= 0:
+            raise FlightDataError(f"{name}: ARSP has Airspeed but no DiffPress, and no "
+                                  "ARSPD_RATIO parameter to convert it")
+        eas = arsp["Airspeed"]
+        s.qci_pa = eas * np.abs(eas) / ratio
+        s.pressure_source = f"ARSP.Airspeed converted: q_ci = EAS^2 / ARSPD_RATIO ({ratio:g})"
+        s.conversions.append("the log has airspeed but no differential pressure: q_ci = "
+                             f"ARSP.Airspeed^2 / ARSPD_RATIO ({ratio:g}), ArduPilot's "
+                             "EAS = sqrt(ratio*dp)")
+    else:
+        raise FlightDataError(f"{name}: ARSP has neither DiffPress nor Airspeed")
+
+    baro = data.get("BARO")
+    if baro is not None and "Press" in baro and baro["t"].size:
+        baro = _instance0(baro)
+        s.static_t, s.ps_pa, s.static_source = baro["t"] - t0, baro["Press"], "BARO.Press"
+    if "Temp" in arsp and np.any(arsp["Temp"] != 0):
+        s.temp_t, s.temp_k = s.pressure_t, arsp["Temp"] + 273.15
+        s.temp_source = "ARSP.Temp (airspeed sensor)"
+    elif baro is not None and "Temp" in baro and baro["t"].size:
+        s.temp_t, s.temp_k = baro["t"] - t0, baro["Temp"] + 273.15
+        s.temp_source = "BARO.Temp (baro sensor)"
+
+    gps = data.get("GPS")
+    if gps is not None and gps["t"].size:
+        gps = _instance0(gps)
+        s.gps_t = gps["t"] - t0
+        if "VelN" in gps and "VelE" in gps:
+            s.gps_vn, s.gps_ve = gps["VelN"], gps["VelE"]
+            s.gps_source = "GPS.VelN/VelE"
+        else:
+            crs = np.radians(gps["GCrs"])
+            s.gps_vn, s.gps_ve = gps["Spd"] * np.cos(crs), gps["Spd"] * np.sin(crs)
+            s.gps_source = "GPS.Spd/GCrs"
+        s.gps_vd = gps.get("VelD", gps.get("VZ"))
+        s.gps_source += "/VZ" if "VZ" in gps and "VelD" not in gps else ""
+        s.gps_source += " (Status>=3)"
+        s.gps_ok = gps["Status"] >= 3 if "Status" in gps else np.ones(s.gps_t.size, bool)
+        s.gps_alt_m = gps.get("Alt")
+
+    for wtype in ("XKF2", "NKF2", "EKF2"):
+        wind = data.get(wtype)
+        if wind is not None and wind["t"].size and "VWN" in wind:
+            wind = _instance0(wind, "C")
+            s.wind_t, s.wind_n, s.wind_e = wind["t"] - t0, wind["VWN"], wind["VWE"]
+            s.wind_source = f"{wtype}.VWN/VWE (EKF)"
+            break
+    s.log_duration_s = max((c["t"][-1] - t0 for c in data.values() if c["t"].size),
+                           default=None)
+    return s

@@ -1,0 +1,433 @@
+"""Autopilot flight logs as a `Flight`: PX4 ULog (`.ulg`) and ArduPilot DataFlash (`.bin`, `.log`).
+
+`read_log(path)` returns the `Flight` that `identify` needs; `load_log(path)` returns it inside a
+`FlightLog` with what the autopilot itself estimated (its wind, its airspeed ratio or scale) for
+comparison. The format readers (`estimation.ulog`, `estimation.dataflash`) only pull the raw
+streams out of a file; this module puts them on one time base and cuts what is unusable, the
+same way for every format.
+
+Time
+    ``time_s`` is seconds since the start of the log (the ULog header's timestamp; the first
+    data message's time-stamp in a DataFlash log), so `start_s` / `end_s` and the times in the messages are
+    the numbers a log viewer shows, less the offset of the first message.
+
+One time base
+    The samples are those of the pressure stream (ArduPilot ARSP ~10 Hz, PX4
+    differential_pressure 10-100 Hz): q_ci is the measured output of the output-error model,
+    so its samples are kept as measured, never interpolated. The slower streams are carried onto
+    those times by linear interpolation between their two neighbouring samples (the default):
+    GPS velocity at 5-10 Hz held instead (zero-order hold, ``gps_resample="hold"``) lags by half
+    a GPS period on average, which during the speed sweep and turns is a systematic velocity
+    error, while interpolation between two fixes of a smooth flight path is unbiased. The
+    analysis is post-flight, so using the next fix is legitimate. A pressure sample is given GPS
+    data only when both neighbouring valid fixes are at most ``max(0.5 s, 3 GPS periods)``
+    apart, so an interpolation never bridges a fix-lost gap. Static pressure and temperature
+    change slowly and are interpolated the same way (held at the ends for up to 1 s).
+    `gps_latency_s` shifts the GPS times earlier when the receiver's velocity is known to lag.
+
+What is cut (an INFO log line names every cut with its sample count and time spans)
+    - outside the `start_s`..`end_s` window (not counted as dropped);
+    - no valid GPS: before the first / after the last 3D fix, fix lost (PX4 ``fix_type < 3``
+      or ``vel_ned_valid == 0``, ArduPilot ``Status < 3``) or a gap between fixes;
+    - on the ground or too slow to calibrate: GPS ground speed below `min_groundspeed_mps`
+      (5 m/s) or q_ci below `min_qci_pa` (20 Pa, ~11 kt; the flight CSV reader's threshold);
+    - non-finite values, and repeated time stamps of the pressure stream.
+    Fewer than `MIN_SAMPLES` samples or `MIN_DURATION_S` seconds left is a `FlightDataError`.
+
+Density
+    rho = ps / (R T) with the log's static pressure and a temperature. Neither autopilot logs
+    the outside air temperature: the reader takes the airspeed sensor's temperature where it
+    has one, else the barometer's, and warns that it is the sensor's, not OAT: a sensor 15 K
+    warmer than the air gives a density 5 % low, which the pressure-error model absorbs into
+    k1. Pass `oat_k` (a measured outside air temperature, K) to use it instead. A log without
+    static pressure uses the ISA atmosphere at the GPS altitude, with a warning.
+
+The autopilot's own estimates
+    Kept out of the `Flight`'s arrays: `FlightLog.autopilot_wind` is the wind-estimate series
+    (ArduPilot EKF ``NKF2/XKF2 VWN, VWE``; PX4 ``wind_estimate``), `FlightLog.airspeed_scale`
+    the airspeed ratio / scale parameters (ArduPilot ``ARSPD_RATIO``: EAS = sqrt(ratio · Δp); PX4
+    ``ASPD_SCALE`` and the estimator's ``tas_scale``). Their summaries, the source, firmware and
+    every conversion and cut are also short strings in `Flight.meta`, which `write_flight_csv`
+    writes as ``# key: value`` comment lines.
+"""
+
+import logging
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .errors import FlightDataError, PitotcalError
+from .flight import Flight
+from .units import density_kgm3, isa_pressure_pa, isa_temperature_k
+
+__all__ = ["read_log", "load_log", "FlightLog", "AutopilotWind", "LOG_EXTENSIONS"]
+
+log = logging.getLogger(__name__)
+
+LOG_EXTENSIONS = (".ulg", ".bin", ".log")
+MIN_SAMPLES = 50
+MIN_DURATION_S = 10.0
+_GPS_RESAMPLE = ("linear", "hold")
+_SLOW_HOLD_S = 1.0     # static pressure / temperature may be held this long past their ends
+
+
+@dataclass
+class LogStreams:
+    """Raw streams of one log, times in s since log start (filled by the format readers)."""
+
+    log_format: str = ""
+    autopilot: str = ""
+    log_duration_s: float | None = None
+    pressure_t: np.ndarray | None = None
+    qci_pa: np.ndarray | None = None
+    pressure_source: str = ""
+    static_t: np.ndarray | None = None
+    ps_pa: np.ndarray | None = None
+    static_source: str = ""
+    temp_t: np.ndarray | None = None
+    temp_k: np.ndarray | None = None
+    temp_source: str = ""
+    gps_t: np.ndarray | None = None
+    gps_vn: np.ndarray | None = None
+    gps_ve: np.ndarray | None = None
+    gps_vd: np.ndarray | None = None
+    gps_ok: np.ndarray | None = None
+    gps_alt_m: np.ndarray | None = None
+    gps_source: str = ""
+    wind_t: np.ndarray | None = None
+    wind_n: np.ndarray | None = None
+    wind_e: np.ndarray | None = None
+    wind_source: str = ""
+    airspeed_scale: dict = field(default_factory=dict)
+    conversions: list = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class AutopilotWind:
+    """The autopilot's own wind estimate over the selected window.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (M,)
+        Seconds since log start.
+    wind_n_mps, wind_e_mps : ndarray, shape (M,)
+        Air-mass velocity north / east (the way the wind blows TO), m/s.
+    source : str
+        Log message and fields, e.g. ``NKF2.VWN/VWE (EKF)``.
+    """
+
+    time_s: np.ndarray
+    wind_n_mps: np.ndarray
+    wind_e_mps: np.ndarray
+    source: str
+
+    @property
+    def speed_mps(self):
+        return np.hypot(self.wind_n_mps, self.wind_e_mps)
+
+    @property
+    def from_deg(self):
+        """Direction the wind blows FROM, deg true, [0, 360)."""
+        return np.degrees(np.arctan2(-self.wind_e_mps, -self.wind_n_mps)) % 360.0
+
+
+@dataclass(frozen=True)
+class FlightLog:
+    """A log read for calibration: the `Flight` plus what the autopilot estimated itself.
+
+    Attributes
+    ----------
+    flight : Flight
+        The usable samples (see the module notes for the time base and the cuts).
+    autopilot : str
+        Firmware named in the log, e.g. ``ArduPlane V4.1.0dev (4a688e59)``.
+    log_format : str
+        ``PX4 ULog``, ``ArduPilot DataFlash binary`` or ``ArduPilot DataFlash text``.
+    autopilot_wind : AutopilotWind or None
+        The autopilot's wind estimate inside the window, when logged.
+    airspeed_scale : dict
+        The autopilot's airspeed calibration: ``{"ARSPD_RATIO": 1.9936}`` (ArduPilot) or
+        ``{"ASPD_SCALE": 1.0, "wind_estimate.tas_scale (last)": ..}`` (PX4).
+    excluded : dict
+        Samples cut per reason (inside the window).
+    conversions : tuple of str
+        Every conversion and substitution the reader made (also warned).
+    """
+
+    flight: Flight
+    autopilot: str
+    log_format: str
+    autopilot_wind: AutopilotWind | None
+    airspeed_scale: dict
+    excluded: dict
+    conversions: tuple
+
+
+def read_log(path, start_s=None, end_s=None, **options):
+    """Read a PX4 ULog or ArduPilot DataFlash log as a `Flight` ready for `identify`.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.ulg`` (PX4), ``.bin`` or ``.log`` (ArduPilot DataFlash, binary or text).
+    start_s, end_s : float, optional
+        Window in seconds since the start of the log (either may be None).
+    **options
+        `gps_resample`, `gps_latency_s`, `min_groundspeed_mps`, `min_qci_pa`, `oat_k`: see
+        `load_log`.
+
+    Returns
+    -------
+    Flight
+        Samples on the pressure stream's time base; ``time_s`` in seconds since log start.
+
+    Raises
+    ------
+    FlightDataError
+        Unknown extension, unreadable/truncated/corrupt file, no airspeed data, or too little
+        usable airborne data; one line naming the file and the cause.
+
+    Examples
+    --------
+    >>> flight = read_log("flight.bin", start_s=300, end_s=600)     # doctest: +SKIP
+    """
+    return load_log(path, start_s, end_s, **options).flight
+
+
+def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_latency_s=0.0,
+             min_groundspeed_mps=5.0, min_qci_pa=20.0, oat_k=None):
+    """Read a log as a `FlightLog`: the `Flight` and the autopilot's own estimates.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.ulg``, ``.bin`` or ``.log``.
+    start_s, end_s : float, optional
+        Window, seconds since log start.
+    gps_resample : {"linear", "hold"}
+        GPS onto the pressure times: linear interpolation between the neighbouring fixes, or
+        the last fix at or before each sample (never future data).
+    gps_latency_s : float
+        The GPS velocity refers to this long before its log time stamp, s (>= 0).
+    min_groundspeed_mps : float
+        Samples with a lower GPS ground speed are cut as on the ground, m/s.
+    min_qci_pa : float
+        Samples with a lower impact pressure are cut, Pa.
+    oat_k : float, optional
+        Measured outside air temperature, K, used for density instead of a sensor temperature.
+
+    Returns
+    -------
+    FlightLog
+    """
+    path = Path(path)
+    name = path.name
+    if gps_resample not in _GPS_RESAMPLE:
+        raise PitotcalError(f"gps_resample {gps_resample!r} is not one of {', '.join(_GPS_RESAMPLE)}")
+    for arg, value in (("gps_latency_s", gps_latency_s), ("min_groundspeed_mps",
+                       min_groundspeed_mps), ("min_qci_pa", min_qci_pa)):
+        if not np.isfinite(value) or value < 0:
+            raise PitotcalError(f"{arg} must be a finite number >= 0, got {value!r}")
+    if oat_k is not None and not 150.0 <= oat_k <= 350.0:
+        raise PitotcalError(f"oat_k must be an outside air temperature in kelvin (150-350), "
+                         f"got {oat_k!r}")
+    if start_s is not None and end_s is not None and end_s <= start_s:
+        raise FlightDataError(f"{name}: end_s ({end_s}) must be greater than start_s ({start_s})")
+    suffix = path.suffix.lower()
+    if suffix not in LOG_EXTENSIONS:
+        raise FlightDataError(f"{name}: unknown log extension {path.suffix!r}; expected "
+                              f"{', '.join(LOG_EXTENSIONS)} (or a flight CSV)")
+    if not path.is_file():
+        raise FlightDataError(f"{name}: no such file")
+    if path.stat().st_size == 0:
+        raise FlightDataError(f"{name}: empty file")
+    if suffix == ".ulg":
+        from .ulog import read_ulog_streams
+        streams = read_ulog_streams(path)
+    else:
+        from .dataflash import read_dataflash_streams
+        streams = read_dataflash_streams(path)
+    return _assemble(streams, name, start_s, end_s, gps_resample, gps_latency_s,
+                     min_groundspeed_mps, min_qci_pa, oat_k)
+
+
+# --- one time base, cuts ------------------------------------------------------------------
+
+def _onto(t, ts, values, max_gap_s, hold):
+    """`values` (at sorted times `ts`) at times `t`, and where that is trustworthy.
+
+    Linear: between two neighbours at most `max_gap_s` apart. Hold: the last sample at or
+    before t, at most `max_gap_s` old.
+    """
+    nxt = np.searchsorted(ts, t, side="right")
+    prev = nxt - 1
+    has_prev = prev >= 0
+    prev_c = np.clip(prev, 0, ts.size - 1)
+    if hold:
+        ok = has_prev & (t - ts[prev_c] <= max_gap_s)
+        return values[prev_c], ok
+    nxt_c = np.clip(nxt, 0, ts.size - 1)
+    exact = has_prev & (ts[prev_c] == t)
+    ok = exact | (has_prev & (nxt < ts.size) & (ts[nxt_c] - ts[prev_c] <= max_gap_s))
+    return np.interp(t, ts, values), ok
+
+
+def _clean(t, *arrays):
+    """Sort by time and drop repeated times and non-finite rows of a stream."""
+    good = np.isfinite(t)
+    for a in arrays:
+        good &= np.isfinite(a)
+    t = t[good]
+    arrays = [a[good] for a in arrays]
+    order = np.argsort(t, kind="stable")
+    t = t[order]
+    arrays = [a[order] for a in arrays]
+    first = np.r_[True, np.diff(t) > 0]
+    return (t[first], *[a[first] for a in arrays])
+
+
+def _spans(t, mask, limit=4):
+    """'a-b s' strings of the runs of `mask` (at most `limit`, then '...')."""
+    if not mask.any():
+        return ""
+    edges = np.flatnonzero(np.diff(np.r_[0, mask.view(np.int8), 0]))
+    runs = [f"{t[a]:.1f}-{t[b - 1]:.1f} s" for a, b in zip(edges[::2], edges[1::2])]
+    return ", ".join(runs[:limit]) + (", ..." if len(runs) > limit else "")
+
+
+def _assemble(s, name, start_s, end_s, gps_resample, gps_latency_s, min_gs, min_q, oat_k):
+    t_all, q_all = _clean(np.asarray(s.pressure_t, float), np.asarray(s.qci_pa, float))
+    n_bad_rows = np.asarray(s.pressure_t).size - t_all.size
+    if t_all.size == 0:
+        raise FlightDataError(f"{name}: no finite airspeed samples in the log")
+    lo = -np.inf if start_s is None else start_s
+    hi = np.inf if end_s is None else end_s
+    in_win = (t_all >= lo) & (t_all <= hi)
+    if not in_win.any():
+        raise FlightDataError(f"{name}: no airspeed samples between start_s={start_s} and "
+                              f"end_s={end_s}; the log's airspeed spans "
+                              f"{t_all[0]:.1f}-{t_all[-1]:.1f} s since log start")
+    t, q = t_all[in_win], q_all[in_win]
+    cuts = {}
+
+    # GPS velocity.
+    if s.gps_t is None or s.gps_t.size == 0:
+        raise FlightDataError(f"{name}: no GPS velocity in the log")
+    vd_in = s.gps_vd if s.gps_vd is not None else np.zeros_like(s.gps_t)
+    alt_in = s.gps_alt_m if s.gps_alt_m is not None else np.zeros_like(s.gps_t)
+    valid = np.asarray(s.gps_ok, bool)
+    tg, vn_g, ve_g, vd_g, alt_g = _clean(np.asarray(s.gps_t, float)[valid] - gps_latency_s,
+                                         s.gps_vn[valid], s.gps_ve[valid], vd_in[valid],
+                                         alt_in[valid])
+    if tg.size < 2:
+        raise FlightDataError(f"{name}: no valid GPS velocity in the log "
+                              f"({int(valid.sum())} fixes with a 3D fix of {valid.size})")
+    gap = max(0.5, 3.0 * float(np.median(np.diff(tg))))
+    hold = gps_resample == "hold"
+    vn, gps_ok = _onto(t, tg, vn_g, gap, hold)
+    ve, _ = _onto(t, tg, ve_g, gap, hold)
+    vd, _ = _onto(t, tg, vd_g, gap, hold)
+    alt, _ = _onto(t, tg, alt_g, gap, hold)
+    cuts["no valid GPS fix"] = ~gps_ok
+
+    # Density: static pressure and a temperature.
+    if s.ps_pa is not None and s.static_t is not None and s.static_t.size >= 2:
+        ts, ps_s = _clean(np.asarray(s.static_t, float), np.asarray(s.ps_pa, float))
+        ps = np.interp(t, ts, ps_s)
+        static_ok = (t >= ts[0] - _SLOW_HOLD_S) & (t <= ts[-1] + _SLOW_HOLD_S)
+        cuts["no static pressure"] = ~static_ok
+    else:
+        ps = isa_pressure_pa(alt)
+        s.static_source = "ISA at GPS altitude (no static pressure in the log)"
+        s.conversions.append("no static pressure in the log: ISA pressure at the GPS altitude")
+    if oat_k is not None:
+        temp = np.full_like(t, float(oat_k))
+        temp_source = f"oat_k={oat_k:g} K given by the user"
+    elif s.temp_k is not None and s.temp_t.size >= 2:
+        tt, tk = _clean(np.asarray(s.temp_t, float), np.asarray(s.temp_k, float))
+        temp = np.interp(t, tt, tk)
+        temp_source = f"{s.temp_source}: sensor temperature, not OAT"
+        s.conversions.append(f"no outside air temperature in the log: density uses "
+                             f"{s.temp_source}, a sensor temperature, not OAT (pass oat_k)")
+    else:
+        temp = isa_temperature_k(alt)
+        temp_source = "ISA at GPS altitude (no temperature in the log)"
+        s.conversions.append("no temperature in the log: ISA temperature at the GPS altitude")
+    rho = density_kgm3(ps, temp)
+
+    # On the ground or too slow.
+    gs = np.hypot(vn, ve)
+    cuts[f"ground speed < {min_gs:g} m/s"] = gps_ok & (gs < min_gs)
+    cuts[f"q_ci < {min_q:g} Pa"] = q < min_q
+    cuts["non-finite density"] = ~np.isfinite(rho) | (rho <= 0)
+
+    # Each cut sample is counted once, under the first reason that applies.
+    keep = np.ones(t.size, bool)
+    excluded, attributed = {}, {}
+    for reason, mask in cuts.items():
+        new = mask & keep
+        if new.any():
+            excluded[reason], attributed[reason] = int(new.sum()), new
+            log.info("%s: cut %d of %d samples for %s (%s)", name, new.sum(), t.size, reason,
+                     _spans(t, new))
+        keep &= ~new
+    if n_bad_rows:
+        excluded["non-finite or repeated time"] = int(n_bad_rows)
+        log.info("%s: dropped %d non-finite or repeated pressure samples", name, n_bad_rows)
+    for text in s.conversions:
+        warnings.warn(f"{name}: {text}", stacklevel=3)
+
+    n_keep = int(keep.sum())
+    duration = float(t[keep][-1] - t[keep][0]) if n_keep else 0.0
+    if n_keep < MIN_SAMPLES or duration < MIN_DURATION_S:
+        why = "; ".join(f"{reason}: {int(m.sum())}" for reason, m in cuts.items()
+                        if m.any()) or "none"
+        slow = cuts[f"ground speed < {min_gs:g} m/s"] | cuts[f"q_ci < {min_q:g} Pa"]
+        ground = " (on the ground throughout?)" if slow.mean() > 0.9 else ""
+        raise FlightDataError(
+            f"{name}: too little usable airborne data{ground} ({n_keep} samples over "
+            f"{duration:.1f} s, "
+            f"need {MIN_SAMPLES} over {MIN_DURATION_S:g} s) of {t.size} airspeed samples in "
+            f"{t[0]:.1f}-{t[-1]:.1f} s; failing: {why}")
+
+    wind = None
+    if s.wind_t is not None and s.wind_t.size:
+        w = (s.wind_t >= lo) & (s.wind_t <= hi)
+        wind = AutopilotWind(np.asarray(s.wind_t[w], float), np.asarray(s.wind_n[w], float),
+                             np.asarray(s.wind_e[w], float), s.wind_source)
+    kt = t[keep]
+    meta = {
+        "source": name,
+        "log_format": s.log_format,
+        "autopilot": s.autopilot,
+        "time": "seconds since log start; samples at the pressure stream's times",
+        "window_s": f"{kt[0]:.1f}-{kt[-1]:.1f}" + ("" if start_s is None and end_s is None
+                                                    else f" (asked {start_s}-{end_s})"),
+        "qc_source": s.pressure_source,
+        "static_source": s.static_source,
+        "temperature_source": temp_source,
+        "gps_source": f"{s.gps_source}, {gps_resample} onto the pressure times"
+                      + (f", latency {gps_latency_s:g} s" if gps_latency_s else ""),
+        "excluded": "; ".join(f"{reason}: {n} samples ({_spans(t, attributed[reason], 3)})"
+                              if reason in attributed else f"{reason}: {n}"
+                              for reason, n in excluded.items()) or "none",
+    }
+    for key, value in s.airspeed_scale.items():
+        meta[f"autopilot_{key}"] = f"{value:.6g}"
+    if wind is not None and wind.time_s.size:
+        inside = (wind.time_s >= kt[0]) & (wind.time_s <= kt[-1])
+        if inside.any():
+            wn, we = wind.wind_n_mps[inside].mean(), wind.wind_e_mps[inside].mean()
+            meta["autopilot_wind"] = (f"{wind.source}, mean {np.hypot(wn, we):.2f} m/s from "
+                                      f"{np.degrees(np.arctan2(-we, -wn)) % 360:.0f} deg")
+    flight = Flight(time_s=kt, qci_pa=q[keep], gps_vn_mps=vn[keep], gps_ve_mps=ve[keep],
+                    rho_kgm3=rho[keep],
+                    gps_vd_mps=vd[keep] if s.gps_vd is not None else None,
+                    alt_m=alt[keep] if s.gps_alt_m is not None else None,
+                    source=name, meta=meta, n_dropped=int(t.size - n_keep + n_bad_rows))
+    log.info("%s: %d samples over %.1f s kept (%s)", name, n_keep, duration, s.autopilot)
+    return FlightLog(flight=flight, autopilot=s.autopilot, log_format=s.log_format,
+                     autopilot_wind=wind, airspeed_scale=dict(s.airspeed_scale),
+                     excluded=excluded, conversions=tuple(s.conversions))

@@ -1,0 +1,190 @@
+"""PX4 ULog (`.ulg`) reader: the raw streams of one log, for `estimation.logs`.
+
+Topics read (pyulog), with the field names of older (v1.11-v1.12) and newer (v1.13+) PX4:
+
+- pressure: ``differential_pressure`` (``differential_pressure_pa``, newer; else
+  ``differential_pressure_raw_pa``; the filtered field only if nothing else, since the filter
+  lags). When that topic is missing or logged below `MIN_PRESSURE_RATE_HZ` while ``airspeed``
+  is faster, q_ci comes from ``airspeed.indicated_airspeed_m_s`` as ½ ρ0 IAS² (a warning says
+  so; that IAS already holds PX4's tube and pitot corrections).
+- static pressure: ``vehicle_air_data.baro_pressure_pa``; else ``sensor_baro.pressure`` (hPa in
+  v1.11-v1.12, Pa later: told apart by its magnitude).
+- temperature: the airspeed sensor's (``differential_pressure.temperature``, else
+  ``airspeed.air_temperature_celsius``), else the baro's (``vehicle_air_data.baro_temp_celcius``
+  / ``ambient_temperature``, ``sensor_baro.temperature``). PX4 logs no outside air temperature:
+  these are sensor temperatures, and the reader warns so.
+- GPS: ``vehicle_gps_position`` (or ``sensor_gps``): ``vel_n_m_s, vel_e_m_s, vel_d_m_s``, valid
+  where ``fix_type >= 3`` and ``vel_ned_valid``; altitude ``alt`` (mm) or ``altitude_msl_m``.
+- for comparison only: ``wind_estimate`` (or ``wind``) ``windspeed_north/east`` (the air-mass
+  velocity, the way it blows TO) and ``tas_scale``; the parameter ASPD_SCALE (ASPD_SCALE_1).
+
+Times are ``timestamp_sample`` where a topic has it, else ``timestamp`` (µs since boot); the
+log's zero is the ULog header's start timestamp.
+"""
+
+import contextlib
+import io
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .errors import FlightDataError
+from .units import RHO0_KGM3
+
+MIN_PRESSURE_RATE_HZ = 5.0      # below this a logged pressure topic cannot follow a turn
+_PX4_NO_TEMPERATURE = -1000.0   # PX4's "sensor has no thermometer" value
+
+
+def _topic(ulog, names, instance=None):
+    """Data dict of the first of `names` present, instance 0 (or the lowest), else None."""
+    for name in names:
+        found = [d for d in ulog.data_list if d.name == name]
+        if instance is not None:
+            found = [d for d in found if d.multi_id == instance]
+        if found:
+            best = min(found, key=lambda d: d.multi_id)
+            return name, best.data
+    return None, None
+
+
+def _times_s(data, t0_us):
+    stamp = data["timestamp_sample"] if "timestamp_sample" in data else data["timestamp"]
+    return (np.asarray(stamp, dtype=float) - t0_us) * 1e-6
+
+
+def _first_field(data, names):
+    for name in names:
+        if name in data:
+            return name, np.asarray(data[name], dtype=float)
+    return None, None
+
+
+def _rate_hz(t):
+    return (t.size - 1) / (t[-1] - t[0]) if t.size > 1 and t[-1] > t[0] else 0.0
+
+
+def read_ulog_streams(path):
+    """Read the streams of a PX4 ULog file into a `LogStreams` (times in s since log start)."""
+    from pyulog import ULog
+    from pyulog.core import ULogException  # noqa: F401 (listed for readers: what pyulog raises)
+
+    from .logs import LogStreams
+
+    name = Path(path).name
+    topics = ["differential_pressure", "airspeed", "vehicle_air_data", "sensor_baro",
+              "vehicle_gps_position", "sensor_gps", "wind_estimate", "wind"]
+    # pyulog prints its own complaints about corrupt bytes; keep them out of our stdout.
+    chatter = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(chatter):
+            ulog = ULog(str(path), topics)
+    except Exception as exc:  # pyulog raises bare Exception subclasses and struct/index errors
+        raise FlightDataError(f"{name}: not a readable ULog file ({exc}); "
+                              "truncated or corrupt?") from None
+    s = LogStreams(log_format="PX4 ULog")
+    t0 = ulog.start_timestamp
+    info = ulog.msg_info_dict
+    s.autopilot = f"{info.get('sys_name', 'PX4')} {ulog.get_version_info_str() or ''}".strip()
+    if info.get("ver_sw_branch"):
+        s.autopilot += f" ({info['ver_sw_branch']})"
+    if getattr(ulog, "file_corruption", False):
+        warnings.warn(f"{name}: pyulog found corrupt data in the log; it skipped it",
+                      stacklevel=3)
+    if ulog.last_timestamp > t0:
+        s.log_duration_s = (ulog.last_timestamp - t0) * 1e-6
+    if not ulog.data_list:
+        raise FlightDataError(f"{name}: no logged data after the ULog header; truncated or "
+                              "corrupt file?")
+
+    # Pressure: the differential pressure itself when it is logged fast enough.
+    _, dp = _topic(ulog, ["differential_pressure"])
+    _, asp = _topic(ulog, ["airspeed"])
+    dp_t = _times_s(dp, t0) if dp is not None else np.empty(0)
+    asp_t = _times_s(asp, t0) if asp is not None else np.empty(0)
+    field, dp_pa = (_first_field(dp, ["differential_pressure_pa", "differential_pressure_raw_pa",
+                                      "differential_pressure_filtered_pa"])
+                    if dp is not None else (None, None))
+    slow = dp_pa is not None and _rate_hz(dp_t) < MIN_PRESSURE_RATE_HZ
+    if dp_pa is not None and not (slow and _rate_hz(asp_t) > _rate_hz(dp_t)):
+        s.pressure_t, s.qci_pa = dp_t, dp_pa
+        s.pressure_source = f"differential_pressure.{field} (Pa)"
+    elif asp is not None and "indicated_airspeed_m_s" in asp:
+        ias = np.asarray(asp["indicated_airspeed_m_s"], dtype=float)
+        s.pressure_t = asp_t
+        s.qci_pa = 0.5 * RHO0_KGM3 * np.sign(ias) * ias ** 2
+        why = (f"differential_pressure is logged at only {_rate_hz(dp_t):.1f} Hz"
+               if dp_pa is not None else "the log has no differential_pressure topic")
+        s.pressure_source = "airspeed.indicated_airspeed_m_s converted: q_ci = 0.5 rho0 IAS^2"
+        s.conversions.append(f"{why}; q_ci from airspeed.indicated_airspeed_m_s as "
+                             "0.5*rho0*IAS^2 (IAS already holds PX4's tube corrections)")
+    else:
+        raise FlightDataError(f"{name}: no airspeed data (differential_pressure or airspeed "
+                              "topic) in the log")
+
+    # Static pressure and the temperature used for density.
+    _, air = _topic(ulog, ["vehicle_air_data"])
+    _, baro = _topic(ulog, ["sensor_baro"])
+    baro_temp = None
+    if air is not None and "baro_pressure_pa" in air:
+        s.static_t, s.ps_pa = _times_s(air, t0), np.asarray(air["baro_pressure_pa"], float)
+        s.static_source = "vehicle_air_data.baro_pressure_pa"
+        tfield, tc = _first_field(air, ["ambient_temperature", "baro_temp_celcius"])
+        if tc is not None:
+            baro_temp = (s.static_t, tc, f"vehicle_air_data.{tfield}")
+    elif baro is not None and "pressure" in baro:
+        s.static_t, ps = _times_s(baro, t0), np.asarray(baro["pressure"], float)
+        hpa = np.nanmedian(ps) < 2000.0         # PX4 v1.11-v1.12 logged millibar here
+        s.ps_pa = ps * 100.0 if hpa else ps
+        s.static_source = "sensor_baro.pressure" + (" (hPa, x100)" if hpa else "")
+        if "temperature" in baro:
+            baro_temp = (s.static_t, np.asarray(baro["temperature"], float),
+                         "sensor_baro.temperature")
+    candidates = []
+    if dp is not None and "temperature" in dp:
+        candidates.append((dp_t, np.asarray(dp["temperature"], float),
+                           "differential_pressure.temperature (airspeed sensor)"))
+    if asp is not None and "air_temperature_celsius" in asp:
+        candidates.append((asp_t, np.asarray(asp["air_temperature_celsius"], float),
+                           "airspeed.air_temperature_celsius (airspeed sensor)"))
+    if baro_temp is not None:
+        candidates.append((*baro_temp[:2], baro_temp[2] + " (baro sensor)"))
+    for t, tc, label in candidates:
+        ok = np.isfinite(tc) & (tc > _PX4_NO_TEMPERATURE + 1.0)
+        if ok.sum() >= 2:
+            s.temp_t, s.temp_k, s.temp_source = t[ok], tc[ok] + 273.15, label
+            break
+
+    # GPS velocity and its validity.
+    gname, gps = _topic(ulog, ["vehicle_gps_position", "sensor_gps"])
+    if gps is not None and "vel_n_m_s" in gps:
+        s.gps_t = _times_s(gps, t0)
+        s.gps_vn = np.asarray(gps["vel_n_m_s"], float)
+        s.gps_ve = np.asarray(gps["vel_e_m_s"], float)
+        s.gps_vd = np.asarray(gps["vel_d_m_s"], float) if "vel_d_m_s" in gps else None
+        ok = np.ones(s.gps_t.size, bool)
+        if "fix_type" in gps:
+            ok &= np.asarray(gps["fix_type"]) >= 3
+        if "vel_ned_valid" in gps:
+            ok &= np.asarray(gps["vel_ned_valid"]) != 0
+        s.gps_ok = ok
+        if "altitude_msl_m" in gps:
+            s.gps_alt_m = np.asarray(gps["altitude_msl_m"], float)
+        elif "alt" in gps:
+            s.gps_alt_m = np.asarray(gps["alt"], float) * 1e-3
+        s.gps_source = f"{gname}.vel_n/e/d_m_s (fix_type>=3, vel_ned_valid)"
+
+    # The autopilot's own wind estimate and airspeed scale, for comparison only.
+    wname, wind = _topic(ulog, ["wind_estimate", "wind"])
+    if wind is not None and "windspeed_north" in wind:
+        s.wind_t = _times_s(wind, t0)
+        s.wind_n = np.asarray(wind["windspeed_north"], float)
+        s.wind_e = np.asarray(wind["windspeed_east"], float)
+        s.wind_source = f"{wname}.windspeed_north/east"
+        sfield, scale = _first_field(wind, ["tas_scale", "tas_scale_validated", "tas_scale_raw"])
+        if scale is not None and np.any(scale > 0):
+            s.airspeed_scale[f"{wname}.{sfield} (last)"] = float(scale[scale > 0][-1])
+    for pname in ("ASPD_SCALE", "ASPD_SCALE_1"):
+        if pname in ulog.initial_parameters:
+            s.airspeed_scale[pname] = float(ulog.initial_parameters[pname])
+    return s
