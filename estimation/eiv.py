@@ -10,10 +10,12 @@ import logging
 
 import numpy as np
 
-__all__ = ["gps_update_mask", "estimate_gps_noise_std"]
+__all__ = ["gps_update_mask", "estimate_gps_noise_std", "interpolate_held"]
 
 log = logging.getLogger(__name__)
 
+# Below this fraction of update samples the GPS is taken as sample-and-hold (5 Hz in 50 Hz: 0.1).
+HELD_FRACTION = 0.7
 # Fewer distinct GPS updates than this give a noise estimate too rough to be worth using.
 MIN_UPDATES = 30
 
@@ -76,3 +78,48 @@ def estimate_gps_noise_std(time_s, *channels):
         nugget.append(np.linalg.solve(design, gamma)[0])
     var = float(np.mean(nugget))
     return float(np.sqrt(var)) if var > 0 else 0.0
+
+
+def interpolate_held(time_s, *channels):
+    """Undo sample-and-hold: interpolate GPS velocity between its updates (cubic spline).
+
+    Parameters
+    ----------
+    time_s : ndarray, shape (N,)
+    *channels : ndarray, shape (N,)
+        GPS velocity components, m/s.
+
+    Returns
+    -------
+    channels : tuple of ndarray
+        The interpolated components (the inputs themselves when GPS is not held).
+    noise_factor : float
+        Mean over samples of the GPS noise variance after interpolation relative to
+        sigma_v^2 (below 1: interpolation averages neighbouring fixes).
+
+    Notes
+    -----
+    A held fix is on average half an update period old (0.1 s at 5 Hz). While the airspeed
+    sweeps, that lag shifts |V_g| by dV/dt * 0.1 s, which biased k1 by about 4 sigma at
+    N = 16,000 in the constant model (measured, tests/synthetic.py). Linear interpolation
+    cuts the chord of the turn and shortens |V_g| (-12 sigma without GPS noise, measured);
+    a cubic spline through the fixes does neither. Each update sample is taken as the fix
+    time; after the last update the value is held. The noise factor is measured by passing a
+    fixed white sequence through the same spline (the spline is linear in the data).
+    """
+    from scipy.interpolate import CubicSpline
+
+    update = gps_update_mask(*channels)
+    if update.mean() > HELD_FRACTION or update.sum() < 4:
+        return channels, 1.0
+    t_fix = time_s[update]
+    last = time_s <= t_fix[-1]
+    out = []
+    for c in channels:
+        v = c.copy()
+        v[last] = CubicSpline(t_fix, c[update])(time_s[last])
+        out.append(v)
+    white = np.random.default_rng(0).standard_normal(t_fix.size)
+    spread = CubicSpline(t_fix, white)(time_s[last])
+    factor = (np.sum(spread ** 2) / np.mean(white ** 2) + np.sum(~last)) / time_s.size
+    return tuple(out), float(factor)

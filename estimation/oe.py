@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .covariance import colored_covariance, plain_covariance, to_reported
-from .eiv import estimate_gps_noise_std
+from .eiv import estimate_gps_noise_std, interpolate_held
 from .errors import PitotcalError
 from .models import get_model
 from .result import IdentificationResult, WIND_NAMES
@@ -170,21 +170,23 @@ class OutputErrorProblem:
                                              *vd_list)
         else:
             sigma_v = float(gps_noise_std_mps)
+        vel, noise_factor = interpolate_held(flight.time_s, flight.gps_vn_mps, flight.gps_ve_mps,
+                                             *vd_list)
+        vn, ve = vel[0], vel[1]
+        vd2 = vel[2] ** 2 if has_vd else None
         ncomp = 3 if has_vd else 2
-        c_eiv = ncomp * sigma_v ** 2
-        vd2 = flight.gps_vd_mps ** 2 if has_vd else None
+        var_v = noise_factor * sigma_v ** 2      # per component, after interpolation
+        c_eiv = ncomp * var_v
 
         theta0 = (np.asarray(start, dtype=float) if start is not None
-                  else start_values(m, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps,
-                                    flight.rho_kgm3, vd2, c_eiv))
+                  else start_values(m, flight.qci_pa, vn, ve, flight.rho_kgm3, vd2, c_eiv))
         scales = np.array(list(m.scales) + [1.0, 1.0])
-        r0 = _residual_np(m, theta0, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps,
-                          flight.rho_kgm3, vd2, c_eiv)
+        r0 = _residual_np(m, theta0, flight.qci_pa, vn, ve, flight.rho_kgm3, vd2, c_eiv)
         # robust scale of the start residuals: makes J ~ O(1) whatever the noise level
         s0 = 1.4826 * np.median(np.abs(r0 - np.median(r0)))
         s0 = max(s0, 1e-6 * float(np.mean(flight.qci_pa)), 1e-9)
-        scalars = [c_eiv, 4.0 * sigma_v ** 2, 2.0 * ncomp * sigma_v ** 4, 1.0 / s0 ** 2]
-        parts = [flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
+        scalars = [c_eiv, 4.0 * var_v, 2.0 * ncomp * var_v ** 2, 1.0 / s0 ** 2]
+        parts = [flight.qci_pa, vn, ve, flight.rho_kgm3]
         if has_vd:
             parts.append(vd2)
         p_val = ca.DM(np.concatenate(parts + [np.asarray(scalars)]))

@@ -1,0 +1,202 @@
+"""`identify`: the public entry point of the output-error calibration (issue 2, item 3)."""
+
+import dataclasses
+import logging
+
+import numpy as np
+
+from .errors import FlightDataError, ObservabilityError, PitotcalError
+from .models import MODELS, get_model
+from .oe import OutputErrorProblem
+
+__all__ = ["identify", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG", "MIN_QCI_SPAN", "MAX_CORRELATION"]
+
+log = logging.getLogger(__name__)
+
+MIN_SAMPLES = 50
+# Wind and calibration separate only if the track turns: below half a circle a wind component
+# along the track is indistinguishable from a scale error.
+MIN_TRACK_SPREAD_DEG = 180.0
+# k1 and the second coefficient separate only over a spread of q_ci: (q98 - q2) / median.
+MIN_QCI_SPAN = 0.05
+# Above this |correlation| (plain information matrix) two parameters are not separable.
+MAX_CORRELATION = 0.9995
+
+# Problems are cached per (structure, IPOPT options): building costs more than solving.
+_PROBLEMS = {}
+
+
+def identify(flight, model="inverse", *, gps_noise_std_mps=None, ipopt_options=None):
+    """Identify the pressure-error model and the wind from one calibration flight.
+
+    Parameters
+    ----------
+    flight : estimation.flight.Flight
+        Time, measured impact pressure q_ci, GPS ground velocity, density (SI).
+    model : {"inverse", "constant", "linear", "auto"}
+        Pressure-error structure (INTERFACES §2); "auto" fits every structure in
+        `estimation.models.MODELS` and keeps the one with the lowest BIC.
+    gps_noise_std_mps : float, optional
+        GPS velocity noise per component, m/s, for the errors-in-variables correction;
+        estimated from the data when None.
+    ipopt_options : dict, optional
+        IPOPT options (without the ``ipopt.`` prefix), e.g. ``{"max_iter": 50}``.
+
+    Returns
+    -------
+    IdentificationResult
+        params/std (k..., wind_speed_mps, wind_from_deg), covariance (colored-residual
+        corrected) and covariance_plain, residuals, success/message/iterations, warnings,
+        candidates/criterion with "auto", timing_s.
+
+    Raises
+    ------
+    PitotcalError
+        Unknown model, bad option.
+    FlightDataError
+        Too few samples, non-finite values.
+    ObservabilityError
+        The data cannot separate the wind from the calibration: track spread below
+        MIN_TRACK_SPREAD_DEG, q_ci span too narrow for a two-coefficient model, or a
+        near-singular information matrix (|correlation| > MAX_CORRELATION).
+
+    Notes
+    -----
+    A solver that does not converge is not an exception: `success` is False, `message` is
+    IPOPT's status and `warnings` says so.
+
+    "auto" uses the Bayesian information criterion with an effective sample size,
+    BIC = N_eff ln(RSS / N) + p ln(N_eff), N_eff = N R_vv(0) / sum_k w(k) R_vv(k) (the
+    residuals' long-run variance ratio, same lag window as the covariance). At 50 Hz the
+    residuals are correlated over hundreds of samples; the plain N would reward any extra
+    coefficient that fits turbulence.
+
+    Example
+    -------
+    >>> from tests.synthetic import synthetic_flight        # doctest: +SKIP
+    >>> flight, truth = synthetic_flight(seed=1)             # doctest: +SKIP
+    >>> identify(flight).value("k2")                         # doctest: +SKIP
+    -15.0...
+    """
+    names = tuple(MODELS) + ("auto",)
+    if not isinstance(model, str) or model not in names:
+        raise PitotcalError(f"model {model!r} is not one of {', '.join(names)}")
+    if gps_noise_std_mps is not None and not (np.isfinite(gps_noise_std_mps) and gps_noise_std_mps >= 0):
+        raise PitotcalError(f"gps_noise_std_mps must be a finite number >= 0, not {gps_noise_std_mps!r}")
+    if ipopt_options is not None and not isinstance(ipopt_options, dict):
+        raise PitotcalError(f"ipopt_options must be a dict, not {type(ipopt_options).__name__}")
+    _check_flight(flight)
+    _check_track(flight)
+
+    if model != "auto":
+        return _identify_one(flight, model, gps_noise_std_mps, ipopt_options)
+
+    results, candidates = {}, []
+    for name in MODELS:
+        try:
+            results[name] = _identify_one(flight, name, gps_noise_std_mps, ipopt_options)
+        except ObservabilityError as exc:
+            candidates.append({"model": name, "bic": None, "error": str(exc)})
+    if not results:
+        raise ObservabilityError(f"no model structure is identifiable: {candidates[0]['error']}")
+    best_rss = min(results.values(), key=lambda r: float(r.residuals_pa @ r.residuals_pa))
+    n_eff = _effective_n(best_rss)
+    for name, res in results.items():
+        rss = float(res.residuals_pa @ res.residuals_pa)
+        p = res.internal_params.size
+        bic = n_eff * np.log(rss / res.n_samples) + p * np.log(n_eff)
+        candidates.append({"model": name, "bic": float(bic), "n_eff": float(n_eff),
+                           "n_params": int(p), "noise_std_pa": res.noise_std_pa,
+                           "converged": res.success,
+                           "params": dict(zip(res.param_names, map(float, res.params)))})
+    ok = [c for c in candidates if c["bic"] is not None and c["converged"]] or \
+         [c for c in candidates if c["bic"] is not None]
+    chosen = min(ok, key=lambda c: c["bic"])["model"]
+    order = {name: i for i, name in enumerate(MODELS)}
+    candidates.sort(key=lambda c: order[c["model"]])
+    return dataclasses.replace(results[chosen], candidates=tuple(candidates),
+                               criterion="BIC with effective N (residual long-run variance)")
+
+
+def _identify_one(flight, model, gps_noise_std_mps, ipopt_options):
+    m = get_model(model)
+    if len(m.params) > 1:
+        _check_qci_span(flight, m)
+    key = (model, tuple(sorted((ipopt_options or {}).items())))
+    if key not in _PROBLEMS:
+        _PROBLEMS[key] = OutputErrorProblem(model, ipopt_options=ipopt_options)
+    result = _PROBLEMS[key].solve(flight, gps_noise_std_mps=gps_noise_std_mps)
+    if result.success:
+        _check_information(result)
+    return result
+
+
+def _check_flight(flight):
+    n = flight.n
+    if n < MIN_SAMPLES:
+        raise FlightDataError(f"{flight.source}: {n} samples; identification needs at least {MIN_SAMPLES}")
+    for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps"):
+        values = getattr(flight, name)
+        if values is None:
+            continue
+        if values.shape != (n,):
+            raise FlightDataError(f"{flight.source}: {name} has shape {values.shape}, expected ({n},)")
+        bad = ~np.isfinite(values)
+        if bad.any():
+            raise FlightDataError(f"{flight.source}: {name}, row {int(np.argmax(bad)) + 1}: not finite")
+
+
+def track_spread_deg(vn_mps, ve_mps):
+    """Angular spread of the ground track, degrees: 360 minus the largest empty arc of courses."""
+    moving = np.hypot(vn_mps, ve_mps) > 1.0
+    if moving.sum() < 2:
+        return 0.0
+    course = np.sort(np.degrees(np.arctan2(ve_mps[moving], vn_mps[moving])) % 360.0)
+    gaps = np.diff(np.concatenate([course, [course[0] + 360.0]]))
+    return float(360.0 - gaps.max())
+
+
+def _check_track(flight):
+    spread = track_spread_deg(flight.gps_vn_mps, flight.gps_ve_mps)
+    if spread < MIN_TRACK_SPREAD_DEG:
+        raise ObservabilityError(
+            f"{flight.source}: the ground track turns through only {spread:.0f} deg (need "
+            f">= {MIN_TRACK_SPREAD_DEG:.0f}): wind and calibration cannot be separated; fly turns")
+
+
+def _check_qci_span(flight, model):
+    q2, q50, q98 = np.percentile(flight.qci_pa, [2, 50, 98])
+    span = (q98 - q2) / q50
+    if span < MIN_QCI_SPAN:
+        raise ObservabilityError(
+            f"{flight.source}: q_ci spans only {100 * span:.1f}% of its median (need "
+            f">= {100 * MIN_QCI_SPAN:.0f}%) to separate {model.params[0]} from {model.params[1]} "
+            f"in the {model.name} model; fly a speed range or use the constant model")
+
+
+def _check_information(result):
+    cov = result.internal_covariance_plain
+    s = np.sqrt(np.diag(cov))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(s, s)
+    names = tuple(get_model(result.model).params) + ("wind_n_mps", "wind_e_mps")
+    np.fill_diagonal(corr, 0.0)
+    if not np.all(np.isfinite(corr)):
+        raise ObservabilityError("the information matrix is singular: wind and calibration "
+                                 "cannot be separated")
+    i, j = np.unravel_index(np.argmax(np.abs(corr)), corr.shape)
+    if abs(corr[i, j]) > MAX_CORRELATION:
+        raise ObservabilityError(
+            f"near-singular information matrix: {names[i]} and {names[j]} correlated "
+            f"{corr[i, j]:+.5f}; the data cannot separate them")
+
+
+def _effective_n(result):
+    from .covariance import lag_weights, residual_acf, truncation_lag
+
+    r = result.residuals_pa
+    lag, _ = truncation_lag(r)
+    acov = residual_acf(r, lag)
+    w = lag_weights(lag)
+    long_run = acov[0] + 2.0 * float(np.sum(w[1:] * acov[1:]))
+    return float(np.clip(r.size * acov[0] / max(long_run, 1e-300), 1.0, r.size))
