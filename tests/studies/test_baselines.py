@@ -1,0 +1,88 @@
+"""Peer baselines (studies/baselines.py) recover a known scale and wind on seeded flights."""
+
+import numpy as np
+import pytest
+
+from estimation.errors import PitotcalError
+from studies.baselines import (ardupilot_autocal, ardupilot_ratio_from_k1, delta_v_kt_from_k1,
+                               k1_from_ardupilot_ratio, px4_wind_estimator)
+from synthetic import synthetic_flight
+
+K1 = 0.05
+
+
+@pytest.fixture(scope="module")
+def clean_flight():
+    """600 s, six full turns, constant-model error k1 = 0.05, 5 m/s wind from 270 deg."""
+    return synthetic_flight(seed=3, n=50 * 600, model="constant", k=(K1,), turns=6,
+                            qc_noise_pa=0.3)
+
+
+@pytest.fixture(scope="module")
+def rough_flight():
+    """The same with turbulence and 5 Hz noisy GPS."""
+    return synthetic_flight(seed=4, n=50 * 600, model="constant", k=(K1,), turns=6,
+                            turbulence_mps=0.5, gps_rate_hz=5.0, gps_noise_mps=0.05)
+
+
+def test_ratio_k1_round_trip():
+    assert k1_from_ardupilot_ratio(ardupilot_ratio_from_k1(0.14)) == pytest.approx(0.14)
+    # a perfect sensor is ratio 2/rho0 = 1.633; ArduPilot's default 1.9936 means k1 = 0.18
+    assert k1_from_ardupilot_ratio(2.0 / 1.225) == pytest.approx(0.0, abs=1e-12)
+    assert k1_from_ardupilot_ratio(1.9936) == pytest.approx(0.181, abs=1e-3)
+    assert delta_v_kt_from_k1(0.05, 85.0) == pytest.approx(85.0 * (0.95 ** -0.5 - 1.0))
+
+
+@pytest.mark.parametrize("filt, k1_tol, wind_tol", [
+    (ardupilot_autocal, 0.005, 0.3),
+    (px4_wind_estimator, 0.01, 0.3),
+])
+def test_baseline_converges_on_clean_flight(clean_flight, filt, k1_tol, wind_tol):
+    flight, truth = clean_flight
+    tr = filt(flight)
+    end = tr.at(flight.time_s[-1])
+    assert end["k1"] == pytest.approx(K1, abs=k1_tol)
+    assert end["wind_n_mps"] == pytest.approx(truth["wind_n_mps"], abs=wind_tol)
+    assert end["wind_e_mps"] == pytest.approx(truth["wind_e_mps"], abs=wind_tol)
+    # stated uncertainty shrinks from the start and covers the truth at the end
+    assert tr.k1_std[-1] < tr.k1_std[len(tr.k1_std) // 20] or filt is ardupilot_autocal
+    assert abs(end["k1"] - K1) <= end["k1_2sigma"]
+
+
+@pytest.mark.parametrize("filt", [ardupilot_autocal, px4_wind_estimator])
+def test_baseline_in_turbulence(rough_flight, filt):
+    flight, truth = rough_flight
+    tr = filt(flight)
+    end = tr.at(flight.time_s[-1], vi_kt=85.0)
+    assert end["k1"] == pytest.approx(K1, abs=0.015)
+    assert end["wind_speed_mps"] == pytest.approx(truth["parameters"]["wind_speed_mps"], abs=0.6)
+    assert end["dv_2sigma_kt"] > 0
+    assert tr.n_resets == 0
+
+
+def test_ardupilot_is_slow_by_design(clean_flight):
+    """P0 = 1e-6 and Q = 5e-7/s on z: after 60 s the ratio has barely left its start."""
+    flight, _ = clean_flight
+    tr = ardupilot_autocal(flight)
+    assert tr.at(60.0)["k1"] < 0.5 * K1
+    assert tr.time_s[1] - tr.time_s[0] == pytest.approx(1.0)
+
+
+def test_px4_validation_needs_all_course_bins():
+    """Straight flight never fills the 12 course bins: the validated scale stays at its start."""
+    flight, _ = synthetic_flight(seed=5, n=50 * 120, model="constant", k=(K1,), turns=0.5)
+    tr = px4_wind_estimator(flight)
+    assert np.all(tr.k1_validated == 0.0)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda f: ardupilot_autocal("x"), "must be an estimation.flight.Flight"),
+    (lambda f: ardupilot_autocal(f, rate_hz=0), "rate_hz must be a positive"),
+    (lambda f: ardupilot_autocal(f, initial_ratio=-1), "initial_ratio must be a positive"),
+    (lambda f: px4_wind_estimator(f, tas_noise_mps=float("nan")), "tas_noise_mps must be"),
+    (lambda f: px4_wind_estimator(f, gate_sd=-3), "gate_sd must be a positive"),
+    (lambda f: ardupilot_autocal(f).at(-5.0), "no filter update before"),
+])
+def test_errors(clean_flight, call, match):
+    with pytest.raises(PitotcalError, match=match):
+        call(clean_flight[0])

@@ -1,0 +1,91 @@
+"""Real ArduPlane flight (ALFA Carbon-Z): reader and the comparison with the autopilot."""
+
+import json
+
+import numpy as np
+import pytest
+
+from estimation.errors import FlightDataError, PitotcalError
+from studies.real_alfa import read_alfa_flight, run_real_alfa
+
+
+_CACHE = {}
+
+
+@pytest.fixture
+def alfa_summary(shared_data, tmp_path_factory):
+    """The study run once per module (it takes ~2 s), skipped without the shared data."""
+    if "run" not in _CACHE:
+        out = tmp_path_factory.mktemp("real-alfa")
+        _CACHE["run"] = (run_real_alfa(out, data_dir=shared_data / "alfa-carbonz"), out)
+    return _CACHE["run"]
+
+
+def test_reader_builds_powered_segment(shared_data):
+    f = read_alfa_flight(shared_data / "alfa-carbonz")
+    t_fail = float(f.meta["failure_time_s"])
+    assert t_fail == pytest.approx(116.25, abs=0.1)
+    assert f.time_s[-1] < t_fail
+    assert f.n > 1000 and np.all(np.diff(f.time_s) > 0)
+    # 10 Hz pressure, ~130 Pa (≈ 15 m/s), ground speed ~ 18 m/s, density of a warm 970 hPa day
+    assert 50 < np.median(f.qci_pa) < 250
+    assert 10 < np.median(np.hypot(f.gps_vn_mps, f.gps_ve_mps)) < 25
+    assert 1.05 < np.median(f.rho_kgm3) < 1.2
+    assert f.gps_vd_mps is not None
+
+
+def test_reader_density_choices(shared_data):
+    d = shared_data / "alfa-carbonz"
+    isa = read_alfa_flight(d, oat="isa")
+    hot = read_alfa_flight(d, oat=310.0)
+    assert np.median(isa.rho_kgm3) > np.median(hot.rho_kgm3)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"oat": "chip"}, "oat must be 'autopilot', 'isa' or a temperature"),
+    ({"oat": 25.0}, "oat must be a temperature in K"),
+    ({"margin_s": -1}, "margin_s must be >= 0"),
+])
+def test_reader_errors(shared_data, kwargs, match):
+    with pytest.raises(PitotcalError, match=match):
+        read_alfa_flight(shared_data / "alfa-carbonz", **kwargs)
+
+
+def test_reader_missing_dir(tmp_path):
+    with pytest.raises(FlightDataError, match="not found"):
+        read_alfa_flight(tmp_path / "nowhere")
+
+
+def test_summary_keys_and_files(alfa_summary):
+    s, out = alfa_summary
+    for key in ("segment_s", "pitotcal", "autopilot", "peers", "comparison", "failure_time_s"):
+        assert key in s
+    assert set(s["pitotcal"]) == {"constant", "inverse"}
+    assert set(s["peers"]) == {"ardupilot", "px4"}
+    for name in ("real-alfa.csv", "real-alfa.json", "real-alfa.png", "real-alfa_tracks.csv"):
+        assert (out / name).is_file()
+    assert json.loads((out / "real-alfa.json").read_text())["study"] == "real-alfa"
+
+
+def test_calibration_plausible_and_compared(alfa_summary):
+    s, _ = alfa_summary
+    c = s["pitotcal"]["constant"]
+    assert c["converged"]
+    # a small UAV pitot reads low: k1 between 0.05 and 0.3, known to a few hundredths
+    assert 0.05 < c["k1"]["value"] < 0.3
+    assert c["k1"]["2sigma"] < 0.05
+    # light wind, well determined (the track covers every heading)
+    assert 0.5 < c["wind_speed_mps"]["value"] < 4.0
+    assert c["wind_speed_mps"]["2sigma"] < 1.0
+    # the autopilot flew with a fixed ARSPD_RATIO of 1.898 (its autocal did not learn)
+    ap = s["autopilot"]
+    assert ap["ratio"] == pytest.approx(1.898, abs=1e-3)
+    assert not ap["autocal_learning"]
+    cmp_ = s["comparison"]
+    # our k1 agrees with the autopilot's ratio within ~1.5 of our 2-sigma: an IAS difference
+    # of about 1.5 %
+    assert abs(cmp_["k1_difference_in_2sigma"]) < 1.5
+    assert abs(cmp_["ias_error_of_autopilot_ratio_pct"]) < 3.0
+    # and our wind agrees with the autopilot's settled (second-half) wind within ~0.5 m/s, 20 deg
+    assert abs(cmp_["wind_speed_difference_late_mps"]) < 0.5
+    assert abs(cmp_["wind_from_difference_late_deg"]) < 20.0
