@@ -1,0 +1,274 @@
+"""What a plan becomes for the people and machines that fly it.
+
+- pilot card, plain text and PNG: time, target KCAS +-5, bank / heading cues, in knots and feet;
+- auto-throttle setpoints CSV: time, CAS command, acceleration feed-forward;
+- plan figure: ground track inside the circle with the wind arrow, CAS against time, and the
+  histogram of q on a uniform time grid (it should be flat for the continuous profile).
+
+Figures use `matplotlib.figure.Figure` directly (no pyplot state, no GUI backend), so the
+library can be used from scripts, tests and worker processes alike.
+"""
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from estimation.units import mps_to_kt, m_to_ft
+from maneuvers.plan import write_plan
+
+__all__ = ["pilot_card_text", "write_pilot_card", "autothrottle_setpoints",
+           "write_autothrottle_csv", "plot_plan", "write_plan_outputs", "output_paths"]
+
+_TOL_KT = 5.0           # paper section IV: airspeed within +-5 KCAS of target
+_TOL_FT = 50.0          # and altitude within +-50 ft
+
+
+def _cue_indices(plan, cue_s):
+    """Nodes every `cue_s` seconds, plus every ramp start / end (where the speed law bends)."""
+    t = plan.time_s
+    marks = set(np.searchsorted(t, np.arange(t[0], t[-1] + 1e-9, cue_s)).clip(0, plan.n - 1))
+    accel = np.diff(plan.tas_mps) / np.diff(t)
+    bends = np.flatnonzero(np.abs(np.diff(accel)) > 0.05) + 1
+    marks.update(int(b) for b in bends)
+    marks.add(plan.n - 1)
+    return np.array(sorted(marks))
+
+
+def _bank_cue(bank_deg):
+    if abs(bank_deg) < 0.5:
+        return "level"
+    return f"{'R' if bank_deg > 0 else 'L'}{abs(bank_deg):.0f}°"
+
+
+def _speed_cue(plan, k, accel, kcas_rate):
+    """What the throttle hand does from node k on: hold, accelerate to a level, or a trend."""
+    if k >= accel.size:
+        return "end"
+    if abs(accel[k]) < 1e-3:
+        return "hold"
+    if abs(accel[k]) > 0.3:
+        # a ramp: name the speed at its end
+        end = k
+        while end < accel.size and abs(accel[end] - accel[k]) < 1e-3:
+            end += 1
+        verb = "accelerate" if accel[k] > 0 else "decelerate"
+        return f"{verb} to {mps_to_kt(plan.cas_mps[end]):.0f}"
+    return f"{kcas_rate[k]:+.2f} kt/s"
+
+
+def pilot_card_text(plan, cue_s=15.0):
+    """The pilot card as plain text (knots, feet, degrees true).
+
+    Parameters
+    ----------
+    plan : maneuvers.plan.Plan
+    cue_s : float
+        Interval of the cue rows, s (ramp starts and ends are always cued).
+
+    Returns
+    -------
+    str
+    """
+    s = plan.settings
+    alt_ft = float(m_to_ft(np.mean(plan.alt_m)))
+    wind_kt = float(mps_to_kt(s.get("wind_speed_mps", 0.0)))
+    lines = [
+        f"PITOT-STATIC CALIBRATION - {str(s.get('profile', '?')).upper()} "
+        f"{mps_to_kt(plan.cas_mps.min()):.0f}-{mps_to_kt(plan.cas_mps.max()):.0f} KCAS, "
+        f"{plan.time_s[-1] - plan.time_s[0]:.0f} s",
+        f"Altitude {alt_ft:.0f} ft +-{_TOL_FT:.0f} ft | airspeed target +-{_TOL_KT:.0f} KCAS | "
+        f"stay within {m_to_ft(s.get('radius_m', np.nan)):.0f} ft of centre",
+        f"Turns {s.get('turn', 'right')}, bank max {s.get('bank_max_deg', '?')}° | "
+        f"expected wind {s.get('wind_from_deg', 0):03.0f}° / {wind_kt:.0f} kt",
+        "",
+        f"{'TIME':>5}  {'KCAS':>9}  {'BANK':>5}  {'HDG':>4}  {'FROM CTR':>9}  SPEED CUE",
+    ]
+    accel = np.diff(plan.tas_mps) / np.diff(plan.time_s)
+    kcas_rate = np.diff(mps_to_kt(plan.cas_mps)) / np.diff(plan.time_s)
+    for k in _cue_indices(plan, cue_s):
+        t = plan.time_s[k] - plan.time_s[0]
+        kcas = float(mps_to_kt(plan.cas_mps[k]))
+        dist_ft = float(m_to_ft(np.hypot(plan.north_m[k], plan.east_m[k])))
+        hdg = (round(plan.heading_deg[k] / 5.0) * 5) % 360
+        lines.append(f"{int(t // 60):2d}:{int(t % 60):02d}  {kcas:5.1f}±{_TOL_KT:.0f}  "
+                     f"{_bank_cue(plan.bank_deg[k]):>5}  {hdg:03.0f}°  {dist_ft:6.0f} ft  "
+                     f"{_speed_cue(plan, k, accel, kcas_rate)}")
+    return "\n".join(lines) + "\n"
+
+
+def write_pilot_card(plan, png_path=None, txt_path=None, cue_s=15.0):
+    """Write the pilot card as plain text and/or PNG; returns the paths written."""
+    text = pilot_card_text(plan, cue_s)
+    written = []
+    if txt_path is not None:
+        Path(txt_path).write_text(text)
+        written.append(Path(txt_path))
+    if png_path is not None:
+        from matplotlib.figure import Figure
+
+        rows = text.splitlines()
+        height = 2.9 + 0.135 * len(rows)
+        fig = Figure(figsize=(8.27, height))
+        # top: the speed trace with its tolerance band, what the pilot is judged against
+        ax = fig.add_axes([0.09, 1 - 2.1 / height, 0.8, 1.8 / height])
+        kt = mps_to_kt(plan.cas_mps)
+        ax.fill_between(plan.time_s, kt - _TOL_KT, kt + _TOL_KT, color="tab:blue", alpha=0.2,
+                        label=f"±{_TOL_KT:.0f} KCAS")
+        ax.plot(plan.time_s, kt, color="tab:blue", label="target KCAS")
+        ax2 = ax.twinx()
+        ax2.plot(plan.time_s, plan.bank_deg, color="tab:red", lw=0.8, label="bank")
+        ax2.set_ylabel("bank, deg (+right)", color="tab:red")
+        ax.set_xlabel("time, s")
+        ax.set_ylabel("KCAS")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper left", fontsize=8)
+        fig.text(0.04, 1 - 2.65 / height, text, family="monospace", fontsize=8,
+                 va="top")
+        fig.savefig(png_path, dpi=110)
+        written.append(Path(png_path))
+    return written
+
+
+def autothrottle_setpoints(plan, rate_hz=None):
+    """Auto-throttle setpoints: CAS command and the acceleration feed-forward.
+
+    Parameters
+    ----------
+    plan : maneuvers.plan.Plan
+    rate_hz : float, optional
+        Resample to this rate; default: the plan's own nodes.
+
+    Returns
+    -------
+    dict of ndarray
+        ``time_s``, ``cas_cmd_kt``, ``cas_cmd_mps``, ``tas_cmd_mps``, ``accel_ff_mps2``.
+
+    Notes
+    -----
+    The feed-forward is the true-airspeed acceleration of the interval that starts at each
+    time (TAS is linear inside a planner interval), held to the end.
+    """
+    t, tas, cas = plan.time_s, plan.tas_mps, plan.cas_mps
+    accel = np.diff(tas) / np.diff(t)
+    if rate_hz is None:
+        time_s = t
+    else:
+        time_s = np.arange(t[0], t[-1] + 0.5 / rate_hz, 1.0 / rate_hz)
+    idx = np.clip(np.searchsorted(t, time_s, side="right") - 1, 0, accel.size - 1)
+    cas_cmd = np.interp(time_s, t, cas)
+    return {"time_s": time_s, "cas_cmd_kt": mps_to_kt(cas_cmd), "cas_cmd_mps": cas_cmd,
+            "tas_cmd_mps": np.interp(time_s, t, tas), "accel_ff_mps2": accel[idx]}
+
+
+def write_autothrottle_csv(plan, path, rate_hz=None):
+    """Write `autothrottle_setpoints` as CSV with the plan settings as `#` comments."""
+    sp = autothrottle_setpoints(plan, rate_hz)
+    path = Path(path)
+    with path.open("w", newline="") as fh:
+        for key in ("profile", "cas_min_kt", "cas_max_kt", "altitude_m", "accel_max_mps2"):
+            if key in plan.settings:
+                fh.write(f"# {key}: {json.dumps(plan.settings[key])}\n")
+        writer = csv.writer(fh)
+        writer.writerow(list(sp))
+        for row in zip(*sp.values()):
+            writer.writerow([f"{row[0]:.3f}"] + [f"{v:.6g}" for v in row[1:]])
+    return path
+
+
+def plot_plan(plan, path=None):
+    """Plan figure: ground track + circle + wind arrow, CAS vs time, histogram of q.
+
+    Parameters
+    ----------
+    plan : maneuvers.plan.Plan
+    path : path-like, optional
+        Save the figure there (PNG).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from matplotlib.figure import Figure
+
+    s = plan.settings
+    fig = Figure(figsize=(13, 4.2), layout="constrained")
+    ax_track, ax_cas, ax_q = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.1, 1.3, 1]})
+    radius = float(s.get("radius_m", np.hypot(plan.north_m, plan.east_m).max()))
+    theta = np.linspace(0, 2 * np.pi, 361)
+    ax_track.plot(radius * np.sin(theta), radius * np.cos(theta), "k--", lw=1,
+                  label=f"radius {radius:.0f} m")
+    sc = ax_track.scatter(plan.east_m, plan.north_m, c=plan.time_s, s=4, cmap="viridis")
+    ax_track.plot(plan.east_m[0], plan.north_m[0], "go", ms=6, label="start")
+    ax_track.plot(plan.east_m[-1], plan.north_m[-1], "rs", ms=6, label="end")
+    wind = float(s.get("wind_speed_mps", 0.0))
+    if wind > 0:
+        # arrow drawn the way the air moves, entering from the side the wind comes from
+        from_rad = np.radians(float(s.get("wind_from_deg", 0.0)))
+        d_e, d_n = -np.sin(from_rad), -np.cos(from_rad)
+        start = -0.95 * radius * np.array([d_e, d_n])
+        ax_track.annotate("", xy=start + 0.45 * radius * np.array([d_e, d_n]), xytext=start,
+                          arrowprops={"arrowstyle": "-|>", "color": "tab:red", "lw": 2})
+        ax_track.text(*start, f"wind {wind:g} m/s\nfrom {s.get('wind_from_deg', 0):.0f}°",
+                      color="tab:red", fontsize=8, ha="center", va="bottom")
+    ax_track.set_aspect("equal")
+    ax_track.set_xlabel("east, m")
+    ax_track.set_ylabel("north, m")
+    ax_track.set_title("ground track")
+    ax_track.legend(loc="lower right", fontsize=7)
+    fig.colorbar(sc, ax=ax_track, label="time, s", shrink=0.8)
+
+    kt = mps_to_kt(plan.cas_mps)
+    ax_cas.fill_between(plan.time_s, kt - _TOL_KT, kt + _TOL_KT, alpha=0.2,
+                        label=f"±{_TOL_KT:.0f} KCAS")
+    ax_cas.plot(plan.time_s, kt, label="target CAS")
+    ax_cas.set_xlabel("time, s")
+    ax_cas.set_ylabel("CAS, kt")
+    ax_cas.set_title(f"{s.get('profile', '')} schedule")
+    ax_cas.grid(alpha=0.3)
+    ax_cas.legend(fontsize=8)
+
+    # the estimator sees samples at a fixed rate: weigh q by time, not by (non-uniform) node
+    t_uniform = np.arange(plan.time_s[0], plan.time_s[-1], 0.1)
+    ax_q.hist(np.interp(t_uniform, plan.time_s, plan.qc_pa), bins=24, color="tab:green")
+    ax_q.set_xlabel("target q_c, Pa")
+    ax_q.set_ylabel("samples at 10 Hz")
+    ax_q.set_title("distribution of impact pressure")
+    if path is not None:
+        fig.savefig(path, dpi=110)
+    return fig
+
+
+def output_paths(plan_csv):
+    """Where the companions of PLAN.csv go: card (txt, png), auto-throttle CSV, figure."""
+    plan_csv = Path(plan_csv)
+    stem = plan_csv.with_suffix("") if plan_csv.suffix.lower() == ".csv" else plan_csv
+    return {"plan": plan_csv,
+            "card_txt": Path(f"{stem}.card.txt"),
+            "card_png": Path(f"{stem}.card.png"),
+            "autothrottle": Path(f"{stem}.autothrottle.csv"),
+            "figure": Path(f"{stem}.png")}
+
+
+def write_plan_outputs(plan, plan_csv, *, figures=True):
+    """Write the plan CSV and its companions beside it; returns {kind: path}.
+
+    Parameters
+    ----------
+    plan : maneuvers.plan.Plan
+    plan_csv : path-like
+        The plan CSV (INTERFACES §4); the others take its stem: ``.card.txt``, ``.card.png``,
+        ``.autothrottle.csv`` and ``.png``.
+    figures : bool
+        Write the PNGs (matplotlib is the slow part).
+    """
+    paths = output_paths(plan_csv)
+    write_plan(plan, paths["plan"])
+    write_pilot_card(plan, paths["card_png"] if figures else None, paths["card_txt"])
+    write_autothrottle_csv(plan, paths["autothrottle"])
+    if figures:
+        plot_plan(plan, paths["figure"])
+    else:
+        del paths["card_png"], paths["figure"]
+    return paths
