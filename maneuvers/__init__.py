@@ -1,5 +1,14 @@
 """Maneuvers: the shared point-mass dynamics, the planner, the simulator."""
 
+# Planner and its outputs (issue 3, items 1-3).
+from maneuvers.outputs import plot_plan, write_plan_outputs
+from maneuvers.plan import Plan, read_plan, write_plan
+from maneuvers.planner import ManeuverProblem, plan_maneuver
+from maneuvers.profiles import PROFILES
+
+__all__ = ["plan_maneuver", "ManeuverProblem", "Plan", "read_plan", "write_plan",
+           "write_plan_outputs", "plot_plan", "PROFILES"]
+
 # Simulator, turbulence and auto-throttle (issue 3, items 4-5).
 from maneuvers.autothrottle import (AutothrottleCheck, SpeedLoop, check_autothrottle,
                                     tune_autothrottle)
