@@ -22,8 +22,6 @@ GPS week time in ``TimeMS`` and the boot time in ``T`` (ms), which is used. The 
 the time-stamp of the first data message in it.
 """
 
-import contextlib
-import io
 import re
 import warnings
 from pathlib import Path
@@ -81,12 +79,13 @@ def _scan(path):
     """Read the wanted messages: ({type: columns}, params, firmware, log start, n_messages)."""
     from pymavlink import mavutil
 
+    from .logs import captured_output
+
     name = Path(path).name
     collectors, firmware, n_data, t_first = {}, None, 0, np.inf
-    # pymavlink prints "bad header" / "Skipped N bad bytes" on stdout: catch it, report it once.
-    chatter = io.StringIO()
+    # pymavlink prints "bad header" / "Skipped N bad bytes" lines: catch them, report once.
     try:
-        with contextlib.redirect_stdout(chatter):
+        with captured_output() as chatter:
             log = mavutil.mavlink_connection(str(path), dialect="ardupilotmega")
             if type(log).__name__ not in ("DFReader_binary", "DFReader_text"):
                 raise FlightDataError(f"{name}: not an ArduPilot DataFlash log "
@@ -127,7 +126,7 @@ def _scan(path):
         warnings.warn(f"{name}: skipped {sum(map(int, skipped))} corrupt bytes in the log",
                       stacklevel=4)
     if n_data == 0:
-        raise FlightDataError(f"{name}: no data messages in the log (only format headers); "
+        raise FlightDataError(f"{name}: no data messages in the log; "
                               "truncated or corrupt file?")
     data = {k: c.columns() for k, c in collectors.items()}
     return data, params, firmware, (0.0 if not np.isfinite(t_first) else t_first), n_data

@@ -51,7 +51,12 @@ The autopilot's own estimates
     writes as ``# key: value`` comment lines.
 """
 
+import contextlib
+import io
 import logging
+import os
+import sys
+import tempfile
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -71,6 +76,38 @@ MIN_SAMPLES = 50
 MIN_DURATION_S = 10.0
 _GPS_RESAMPLE = ("linear", "hold")
 _SLOW_HOLD_S = 1.0     # static pressure / temperature may be held this long past their ends
+
+
+@contextlib.contextmanager
+def captured_output():
+    """Catch what the log libraries print (pymavlink's C indexer writes to file descriptor 2).
+
+    Yields a StringIO that holds the text once the block ends, so a reader can summarise
+    "skipped N corrupt bytes" in one warning instead of thousands of lines on the terminal.
+    """
+    buf = io.StringIO()
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    try:
+        saved = [os.dup(1), os.dup(2)]
+    except OSError:                      # no real descriptors (embedded use): Python level only
+        with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(buf):
+            yield buf
+        return
+    with tempfile.TemporaryFile() as tmp:
+        os.dup2(tmp.fileno(), 1)
+        os.dup2(tmp.fileno(), 2)
+        try:
+            with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(buf):
+                yield buf
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            for fd in saved:
+                os.close(fd)
+            tmp.seek(0)
+            buf.write(tmp.read().decode("utf-8", "replace"))
 
 
 @dataclass
@@ -350,7 +387,7 @@ def _assemble(s, name, start_s, end_s, gps_resample, gps_latency_s, min_gs, min_
         temp = np.interp(t, tt, tk)
         temp_source = f"{s.temp_source}: sensor temperature, not OAT"
         s.conversions.append(f"no outside air temperature in the log: density uses "
-                             f"{s.temp_source}, a sensor temperature, not OAT (pass oat_k)")
+                             f"{s.temp_source}, a sensor temperature, not OAT (pass oat_k, or --oat-c)")
     else:
         temp = isa_temperature_k(alt)
         temp_source = "ISA at GPS altitude (no temperature in the log)"

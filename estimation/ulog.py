@@ -22,8 +22,6 @@ Times are ``timestamp_sample`` where a topic has it, else ``timestamp`` (µs sin
 log's zero is the ULog header's start timestamp.
 """
 
-import contextlib
-import io
 import warnings
 from pathlib import Path
 
@@ -69,15 +67,14 @@ def read_ulog_streams(path):
     from pyulog import ULog
     from pyulog.core import ULogException  # noqa: F401 (listed for readers: what pyulog raises)
 
-    from .logs import LogStreams
+    from .logs import LogStreams, captured_output
 
     name = Path(path).name
     topics = ["differential_pressure", "airspeed", "vehicle_air_data", "sensor_baro",
               "vehicle_gps_position", "sensor_gps", "wind_estimate", "wind"]
-    # pyulog prints its own complaints about corrupt bytes; keep them out of our stdout.
-    chatter = io.StringIO()
+    # pyulog prints its own complaints about corrupt bytes; keep them off our terminal.
     try:
-        with contextlib.redirect_stdout(chatter):
+        with captured_output() as chatter:
             ulog = ULog(str(path), topics)
     except Exception as exc:  # pyulog raises bare Exception subclasses and struct/index errors
         raise FlightDataError(f"{name}: not a readable ULog file ({exc}); "
