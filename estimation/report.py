@@ -189,8 +189,10 @@ def summary(result):
         crit = result.criterion or "criterion"
         lines += ["", f"Candidate structures ({crit}; lowest chosen):"]
         for cand in result.candidates:
+            # scalars only: the candidates' own parameter dicts would swamp the table
             extra = ", ".join(f"{k}={_fmt(v) if isinstance(v, float) else v}"
-                              for k, v in cand.items() if k != "model")
+                              for k, v in cand.items()
+                              if k != "model" and isinstance(v, (int, float, str, bool)))
             mark = "*" if cand.get("model") == result.model else " "
             lines.append(f"  {mark} {cand.get('model', '?'):<10}{extra}")
     if result.warnings:

@@ -1,0 +1,75 @@
+"""`pitotcal identify`: calibrate from one flight (INTERFACES §3).
+
+Exit status: 0 success (also when the solver did not converge: the summary, the JSON's
+`converged: false` and a stderr warning say so); 2 unusable input, one stderr line naming
+file, column and row; 3 the data cannot separate the wind from the calibration.
+"""
+
+from pathlib import Path
+
+MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "identify", help="identify the pressure error and the wind from a flight",
+        description="Read a flight CSV (or a .ulg/.bin/.log autopilot log), identify the "
+                    "pressure-error model and the wind by the output-error method, print a "
+                    "summary in knots and degrees with 2-sigma bounds, and optionally write the "
+                    "result as JSON and the calibration figure. The input is never modified.")
+    p.add_argument("flight", metavar="FLIGHT", help="flight CSV (INTERFACES §1) or .ulg/.bin/.log")
+    p.add_argument("--model", default="inverse", metavar="NAME",
+                   help="pressure-error structure: inverse, constant, linear, or auto (choose by "
+                        "information criterion and list all candidates); default %(default)s")
+    p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
+    p.add_argument("--plot", metavar="OUT.png", default=None,
+                   help="write the calibration figure (format from the extension)")
+    p.add_argument("--start-s", type=float, default=None, metavar="S",
+                   help="use only samples with time_s >= S")
+    p.add_argument("--end-s", type=float, default=None, metavar="S",
+                   help="use only samples with time_s <= S")
+    p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
+                   help="GPS velocity noise per component, m/s, for the errors-in-variables "
+                        "correction (default: estimated from the data)")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    import json
+    import warnings
+
+    from estimation.errors import PitotcalError
+    from estimation.flight import read_flight
+    from estimation.identify import identify
+    from estimation.models import MODELS
+
+    if args.model not in MODELS and args.model != "auto":
+        raise PitotcalError(f"--model {args.model!r} is not one of "
+                            f"{', '.join([*MODELS, 'auto'])}")
+    if args.gps_noise_mps is not None and not 0.0 <= args.gps_noise_mps < 10.0:
+        raise PitotcalError(f"--gps-noise-mps {args.gps_noise_mps:g} must be between 0 and 10 m/s")
+    source = Path(args.flight)
+    for option, out in (("--json", args.json), ("--plot", args.plot)):
+        # an output on top of the input would destroy the flight data: refuse before anything
+        if out is not None and Path(out).resolve() == source.resolve():
+            raise PitotcalError(f"{option} {out}: would overwrite the input flight file")
+
+    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s)
+    result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
+
+    print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
+          + (f", {flight.n_dropped} rows dropped" if flight.n_dropped else "") + ")")
+    print(result.summary())
+    if not result.converged:
+        warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "
+                      "are not a calibration", stacklevel=2)
+    if args.json is not None:
+        out = {**result.to_dict(), "source": str(source), "n_dropped": int(flight.n_dropped)}
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=2, allow_nan=False)
+            f.write("\n")
+        print(f"\nWrote {args.json}")
+    if args.plot is not None:
+        result.plot(args.plot)
+        print(f"{'' if args.json else chr(10)}Wrote {args.plot}")
+    return 0
