@@ -86,3 +86,20 @@ def test_px4_validation_needs_all_course_bins():
 def test_errors(clean_flight, call, match):
     with pytest.raises(PitotcalError, match=match):
         call(clean_flight[0])
+
+
+def test_compare_peers_one_run(tmp_path):
+    """One short simulated flight through the whole comparison: files, keys, pitotcal refusal."""
+    from studies.compare_peers import run_compare_peers
+    s = run_compare_peers(tmp_path, runs=1, seed=0, times_s=(30.0, 240.0))
+    for name in ("peers.csv", "peers.json", "peers.png"):
+        assert (tmp_path / name).is_file()
+    by = s["by_method"]
+    assert set(by) == {"pitotcal", "ardupilot", "px4"}
+    # after 30 s the track has not turned enough: pitotcal refuses, the filters answer anyway
+    assert by["pitotcal"]["30"]["estimates"] == 0
+    assert by["px4"]["30"]["estimates"] == 1
+    # after the full 240 s plan pitotcal's ΔV is within 0.5 kt and inside its stated 2-sigma
+    e = by["pitotcal"]["240"]
+    assert e["dv_rms_err_kt"] < 0.5 and e["dv_coverage"] == 1.0
+    assert len(s["claims"]) == 4
