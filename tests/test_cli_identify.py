@@ -1,0 +1,164 @@
+"""`pitotcal identify` per INTERFACES §3: outputs, exit statuses 0/2/3, one-line errors."""
+
+import hashlib
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from estimation.flight import write_flight_csv
+from pitotcal.cli import main
+from synthetic import synthetic_flight
+
+N = 4000
+
+
+@pytest.fixture(scope="module")
+def flight_csv(tmp_path_factory):
+    flight, truth = synthetic_flight(seed=5, n=N, turbulence_mps=0.3, gps_rate_hz=5.0,
+                                     gps_noise_mps=0.05)
+    path = write_flight_csv(flight, tmp_path_factory.mktemp("cli") / "flight.csv",
+                            comments={"aircraft": "T-2"})
+    return path, truth
+
+
+def sha(path):
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def test_identify_writes_summary_json_and_plot(flight_csv, tmp_path, capsys):
+    path, truth = flight_csv
+    before = sha(path)
+    out_json, out_png = tmp_path / "r.json", tmp_path / "r.png"
+    status = main(["identify", str(path), "--json", str(out_json), "--plot", str(out_png)])
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    assert sha(path) == before
+    assert captured.out.startswith(f"Flight: {path} ({N} samples, 0.0-80.0 s)")
+    assert "Pressure-error model: inverse   dp/qc = k1 + k2/qci" in captured.out
+    assert "KIAS" in captured.out and "wind from" in captured.out
+    assert f"Wrote {out_json}" in captured.out and f"Wrote {out_png}" in captured.out
+    d = json.loads(out_json.read_text())
+    assert d["model"] == "inverse" and d["n_samples"] == N and d["converged"] is True
+    assert d["source"] == str(path) and d["n_dropped"] == 0
+    assert d["covariance"]["names"] == ["k1", "k2", "wind_speed_mps", "wind_from_deg"]
+    for name, true in truth["parameters"].items():
+        assert abs(d["parameters"][name]["value"] - true) < 3 * d["parameters"][name]["std"]
+    assert out_png.stat().st_size > 20_000
+
+
+def test_model_auto_window_and_gps_noise_option(flight_csv, tmp_path, capsys):
+    path, _ = flight_csv
+    out_json = tmp_path / "r.json"
+    status = main(["identify", str(path), "--model", "auto", "--start-s", "5", "--end-s", "75",
+                   "--gps-noise-mps", "0.05", "--json", str(out_json)])
+    captured = capsys.readouterr()
+    assert status == 0, captured.err
+    d = json.loads(out_json.read_text())
+    assert {c["model"] for c in d["candidates"]} == {"constant", "linear", "inverse"}
+    assert d["criterion"] and "Candidate structures" in captured.out
+    assert d["n_samples"] == 3501 and d["gps_noise_std_mps"] == pytest.approx(0.05)
+
+
+def _write(tmp_path, content, name="bad.csv"):
+    path = tmp_path / name
+    path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    return path
+
+
+def _good_lines(n=200, qc_scale=1.0, nan_rows=()):
+    flight, _ = synthetic_flight(seed=6, n=n)
+    lines = ["time_s,qc_pa,gps_vn_mps,gps_ve_mps,rho_kgm3"]
+    for i in range(n):
+        qc = "nan" if i in nan_rows else f"{flight.qci_pa[i] * qc_scale:.6g}"
+        lines.append(f"{flight.time_s[i]:.3f},{qc},{flight.gps_vn_mps[i]:.6g},"
+                     f"{flight.gps_ve_mps[i]:.6g},{flight.rho_kgm3[i]:.6g}")
+    return lines
+
+
+BAD = [
+    ("empty", "", "bad.csv: empty file"),
+    ("binary", b"ULog\x01\x12\x35\x00\x00", r"bad.csv: PX4 ULog file \(name it \.ulg"),
+    ("header only", "time_s,qc_pa,gps_vn_mps,gps_ve_mps,rho_kgm3\n", "bad.csv: header only"),
+    ("missing column", "time_s,gps_vn_mps,gps_ve_mps,rho_kgm3\n0,1,2,3\n",
+     "bad.csv: missing column qc_pa"),
+    ("no density", "time_s,qc_pa,gps_vn_mps,gps_ve_mps,ps_pa\n0,1,2,3,4\n",
+     r"bad.csv: missing column for density: needs rho_kgm3, or both ps_pa and oat_k"),
+    ("NaN rows", "\n".join(_good_lines(nan_rows=range(10, 20))) + "\n",
+     r"bad.csv: column qc_pa, row 11 \(line 12\): NaN \(10 of 200 rows unusable"),
+    ("duplicate time", "\n".join(_good_lines()[:50] + _good_lines()[49:]) + "\n",
+     r"bad.csv: column time_s, row 50 \(line 51\): time .* duplicates the previous"),
+    ("q_ci in hPa", "\n".join(_good_lines(qc_scale=0.01)) + "\n",
+     r"bad.csv: column qc_pa: median .* looks like hPa"),
+]
+
+
+@pytest.mark.parametrize("case, content, match", BAD, ids=[b[0] for b in BAD])
+def test_bad_input_exits_2_with_one_line(tmp_path, capsys, case, content, match):
+    import re
+
+    path = _write(tmp_path, content)
+    before = sha(path)
+    status = main(["identify", str(path), "--json", str(tmp_path / "r.json")])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert err.count("\n") == 1 and err.startswith("pitotcal identify: ")
+    assert re.search(match, err), err
+    assert "Traceback" not in err and not (tmp_path / "r.json").exists()
+    assert sha(path) == before
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--model", "quadratic"], "--model 'quadratic' is not one of constant, linear, inverse, auto"),
+    (["--start-s", "500"], r"no rows between start_s=500.0 and end_s=None"),
+    (["--start-s", "50", "--end-s", "10"], "start_s=50 must be before end_s=10"),
+    (["--gps-noise-mps", "-1"], "--gps-noise-mps -1 must be between 0 and 10 m/s"),
+])
+def test_bad_options_exit_2(flight_csv, capsys, args, match):
+    import re
+
+    path, _ = flight_csv
+    status = main(["identify", str(path), *args])
+    err = capsys.readouterr().err
+    assert status == 2 and re.search(match, err) and err.count("\n") == 1, err
+
+
+def test_output_on_top_of_input_is_refused(flight_csv, capsys):
+    path, _ = flight_csv
+    before = sha(path)
+    assert main(["identify", str(path), "--json", str(path)]) == 2
+    assert "would overwrite the input flight file" in capsys.readouterr().err
+    assert sha(path) == before
+
+
+def test_missing_file_exits_2(tmp_path, capsys):
+    assert main(["identify", str(tmp_path / "nope.csv")]) == 2
+    assert "nope.csv: No such file or directory" in capsys.readouterr().err
+
+
+def test_no_heading_change_exits_3(tmp_path, capsys):
+    flight, _ = synthetic_flight(seed=7, n=2000, turns=0.1)
+    path = write_flight_csv(flight, tmp_path / "straight.csv")
+    status = main(["identify", str(path)])
+    err = capsys.readouterr().err
+    assert status == 3
+    assert err.count("\n") == 1 and "straight.csv" in err and "turns through only" in err
+
+
+def test_real_subprocess_bad_input_and_good_run(flight_csv, tmp_path):
+    bad = _write(tmp_path, "\n".join(_good_lines(qc_scale=0.001)) + "\n")
+    env = {**os.environ, "PYTHONWARNINGS": "ignore"}
+    proc = subprocess.run([sys.executable, "-m", "pitotcal", "identify", str(bad)],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "looks like kPa" in proc.stderr
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    path, _ = flight_csv
+    proc = subprocess.run([sys.executable, "-m", "pitotcal", "identify", str(path)],
+                          capture_output=True, text=True, env=env, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "Airspeed correction" in proc.stdout
