@@ -114,6 +114,7 @@ def _scan(path):
                         collectors[mtype] = _Collector(msg, _WANTED[mtype])
                     collectors[mtype].add(msg)
             params = dict(getattr(log, "params", {}) or {})
+            log.close()
     except FlightDataError:
         raise
     except (ValueError, OSError, IndexError, KeyError, TypeError, UnicodeDecodeError,

@@ -1,0 +1,201 @@
+"""Writers of small autopilot logs with known content, for the log-reader tests.
+
+Neither pymavlink nor pyulog writes a log from scratch (pyulog's `write_ulog` only re-writes a
+parsed file), so these write the formats directly: ArduPilot DataFlash text and binary (FMT
+messages, then data) and PX4 ULog (header, flag bits, formats, info, parameters, subscriptions,
+data). Each takes a `Flight` (tests/synthetic.py) and writes it the way an autopilot logs it:
+pressure at the flight's own rate, GPS every `gps_every`-th sample, baro and wind slower.
+"""
+
+import struct
+
+import numpy as np
+
+from estimation.units import R_AIR_JKGK
+
+PS_PA = 97000.0            # static pressure written to the logs
+BOOT_S = 20.0              # boot time of the first message
+
+
+def _temperature_k(flight):
+    return PS_PA / (R_AIR_JKGK * flight.rho_kgm3)
+
+
+def _gps_rows(flight, gps_every, invalid=None):
+    """(index, status) of the GPS samples; `invalid` = (t0, t1) span logged with no fix."""
+    idx = np.arange(0, flight.n, gps_every)
+    status = np.full(idx.size, 6 if invalid is None else 3)
+    if invalid is not None:
+        t = flight.time_s[idx]
+        status[(t >= invalid[0]) & (t <= invalid[1])] = 1
+    return idx, status
+
+
+# --- ArduPilot DataFlash ------------------------------------------------------------------
+
+def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", ratio=2.0,
+                      old=False, gps_invalid=None, airspeed_only=False):
+    """(formats, rows) of an ArduPilot log of `flight`: formats {name: (id, fmt, columns)}.
+
+    `old`: ms time stamps (``TimeMS``), GPS velocity as VelN/VelE; `airspeed_only`: ARSP has
+    Airspeed (EAS = sqrt(ratio * dp)) but no DiffPress, as some firmware logs it.
+    """
+    t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
+    time_col, tscale, tfmt = ("TimeMS", 1e-3, "I") if old else ("TimeUS", 1.0, "Q")
+
+    def stamp(i):
+        return int(round(t_us[i] * tscale))
+
+    arsp_cols = ["Airspeed", "Temp"] if airspeed_only else ["Airspeed", "DiffPress", "Temp"]
+    # Old (3.x) GPS messages keep the GPS week time in TimeMS and the boot time in T.
+    gps_cols = (["Status", "Week", "VelN", "VelE", "VZ", "Alt", "T"] if old
+                else ["Status", "GMS", "GWk", "Spd", "GCrs", "VZ", "Alt"])
+    formats = {
+        "PARM": (129, "QNf", "TimeUS,Name,Value"),
+        "MSG": (134, tfmt + "Z", f"{time_col},Message"),
+        "ARSP": (165, tfmt + "f" * len(arsp_cols), ",".join([time_col] + arsp_cols)),
+        "BARO": (139, tfmt + "ff", f"{time_col},Press,Temp"),
+        "GPS": (130, ("IBHffffI" if old else "QBIHffff"), ",".join([time_col] + gps_cols)),
+        "NKF2": (65, tfmt + "Bff", f"{time_col},C,VWN,VWE"),
+    }
+    rows = [(0, "PARM", [int(t_us[0]) - 1000, "ARSPD_RATIO", ratio]),
+            (0, "PARM", [int(t_us[0]) - 1000, "ARSPD_TYPE", 1.0]),
+            (0, "MSG", [stamp(0), firmware])]
+    temp_c = _temperature_k(flight) - 273.15
+    eas = np.sqrt(ratio * flight.qci_pa)
+    for i in range(flight.n):
+        vals = [eas[i], temp_c[i]] if airspeed_only else [eas[i], flight.qci_pa[i], temp_c[i]]
+        rows.append((t_us[i], "ARSP", [stamp(i)] + vals))
+        if i % 5 == 0:
+            rows.append((t_us[i], "BARO", [stamp(i), PS_PA, temp_c[i]]))
+        if i % 10 == 0:
+            rows.append((t_us[i], "NKF2", [stamp(i), 0, -1.0, 0.5]))
+    idx, status = _gps_rows(flight, gps_every, gps_invalid)
+    vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(flight.n)
+    for i, st in zip(idx, status):
+        vn, ve = flight.gps_vn_mps[i], flight.gps_ve_mps[i]
+        gps_ms = 300_000_000 + int(t_us[i] // 1000)
+        if old:
+            vals = [gps_ms, int(st), 2088, vn, ve, vd[i], 100.0, stamp(i)]
+        else:
+            vals = [stamp(i), int(st), gps_ms, 2088, np.hypot(vn, ve),
+                    np.degrees(np.arctan2(ve, vn)) % 360, vd[i], 100.0]
+        rows.append((t_us[i], "GPS", vals))
+    rows.sort(key=lambda r: r[0])
+    return formats, [(name, vals) for _, name, vals in rows]
+
+
+def write_dataflash_text(path, flight, **kw):
+    formats, rows = dataflash_records(flight, **kw)
+    lines = ["FMT, 128, 89, FMT, BBnNZ, Type,Length,Name,Format,Columns"]
+    for name, (mid, fmt, cols) in formats.items():
+        lines.append(f"FMT, {mid}, {3 + struct.calcsize('<' + _struct(fmt))}, {name}, {fmt}, {cols}")
+    for name, vals in rows:
+        lines.append(", ".join([name] + [f"{v:.9g}" if isinstance(v, float) else str(v)
+                                         for v in vals]))
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    return path
+
+
+_STRUCT = {"Q": "Q", "I": "I", "H": "H", "B": "B", "f": "f", "N": "16s", "Z": "64s", "n": "4s"}
+
+
+def _struct(fmt):
+    return "".join(_STRUCT[c] for c in fmt)
+
+
+def write_dataflash_bin(path, flight, **kw):
+    formats, rows = dataflash_records(flight, **kw)
+    out = bytearray()
+    head = b"\xa3\x95"
+
+    def fmt_msg(mid, name, fmt, cols):
+        length = 3 + struct.calcsize("<" + _struct(fmt))
+        return head + bytes([128]) + struct.pack("<BB4s16s64s", mid, length, name.encode(),
+                                                 fmt.encode(), cols.encode())
+
+    out += fmt_msg(128, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns")
+    for name, (mid, fmt, cols) in formats.items():
+        out += fmt_msg(mid, name, fmt, cols)
+    for name, vals in rows:
+        mid, fmt, _ = formats[name]
+        packed = [v.encode() if isinstance(v, str) else (int(v) if c in "QIHB" else float(v))
+                  for v, c in zip(vals, fmt)]
+        out += head + bytes([mid]) + struct.pack("<" + _struct(fmt), *packed)
+    with open(path, "wb") as f:
+        f.write(bytes(out))
+    return path
+
+
+# --- PX4 ULog -----------------------------------------------------------------------------
+
+_ULOG_TYPES = {"uint64_t": "Q", "float": "f", "uint8_t": "B", "int32_t": "i", "bool": "B"}
+
+
+def _msg(kind, payload):
+    return struct.pack("<HB", len(payload), ord(kind)) + payload
+
+
+def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
+               firmware_release=0x010E0000 | 0xFF):
+    """A PX4 ULog of `flight`: newer (v1.13+) or older (v1.11) topic and field names."""
+    t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
+    temp_c = _temperature_k(flight) - 273.15
+    dp_field = "differential_pressure_pa" if newer else "differential_pressure_raw_pa"
+    topics = {
+        "differential_pressure": [("uint64_t", "timestamp"), ("float", dp_field),
+                                  ("float", "temperature")],
+        "vehicle_gps_position": [("uint64_t", "timestamp"), ("float", "vel_n_m_s"),
+                                 ("float", "vel_e_m_s"), ("float", "vel_d_m_s"),
+                                 ("uint8_t", "fix_type"), ("bool", "vel_ned_valid"),
+                                 ("int32_t", "alt")],
+        "wind_estimate": [("uint64_t", "timestamp"), ("float", "windspeed_north"),
+                          ("float", "windspeed_east"), ("float", "tas_scale")],
+    }
+    if newer:
+        topics["vehicle_air_data"] = [("uint64_t", "timestamp"), ("float", "baro_pressure_pa"),
+                                      ("float", "ambient_temperature")]
+    else:
+        topics["sensor_baro"] = [("uint64_t", "timestamp"), ("float", "pressure"),
+                                 ("float", "temperature")]
+    out = bytearray(b"ULog\x01\x12\x35" + bytes([1]) + struct.pack("<Q", int(t_us[0]) - 100000))
+    out += _msg("B", bytes(16) + struct.pack("<3Q", 0, 0, 0))
+    for name, fields in topics.items():
+        out += _msg("F", f"{name}:{''.join(f'{t} {n};' for t, n in fields)}".encode())
+
+    def info(key_type, key, value):
+        k = f"{key_type} {key}".encode()
+        return bytes([len(k)]) + k + value
+
+    out += _msg("I", info("char[3]", "sys_name", b"PX4"))
+    out += _msg("I", info("uint32_t", "ver_sw_release", struct.pack("<I", firmware_release)))
+    out += _msg("P", info("float", "ASPD_SCALE", struct.pack("<f", 1.0)))
+    ids = {}
+    for i, name in enumerate(topics):
+        ids[name] = i
+        out += _msg("A", struct.pack("<BH", 0, i) + name.encode())
+
+    def data(name, values):
+        fmt = "<" + "".join(_ULOG_TYPES[t] for t, _ in topics[name])
+        return _msg("D", struct.pack("<H", ids[name]) + struct.pack(fmt, *values))
+
+    idx_gps, status = _gps_rows(flight, gps_every, gps_invalid)
+    gps_at = dict(zip(idx_gps, status))
+    vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(flight.n)
+    for i in range(flight.n):
+        t = int(t_us[i])
+        out += data("differential_pressure", [t, flight.qci_pa[i], temp_c[i]])
+        if i % 5 == 0:
+            baro = "vehicle_air_data" if newer else "sensor_baro"
+            ps = PS_PA if newer else PS_PA / 100.0          # v1.11 logged hPa here
+            out += data(baro, [t, ps, temp_c[i]])
+        if i in gps_at:
+            fix = 3 if gps_at[i] >= 3 else 0
+            out += data("vehicle_gps_position", [t, flight.gps_vn_mps[i], flight.gps_ve_mps[i],
+                                                 vd[i], fix, int(fix >= 3), 100000])
+        if i % 10 == 0:
+            out += data("wind_estimate", [t, -1.0, 0.5, 1.02])
+    with open(path, "wb") as f:
+        f.write(bytes(out))
+    return path
