@@ -21,7 +21,7 @@ from functools import lru_cache
 import numpy as np
 
 from estimation.errors import PitotcalError, PlanInfeasibleError
-from estimation.units import G0_MPS2, kt_to_mps
+from estimation.units import G0_MPS2, RHO0_KGM3, kt_to_mps, mps_to_kt
 from maneuvers.dynamics import Limits, rhs
 from maneuvers.plan import Plan
 from maneuvers.profiles import PROFILES, make_schedule
@@ -381,7 +381,7 @@ def plan_maneuver(profile="continuous", cas_min_kt=70.0, cas_max_kt=100.0, radiu
                              levels=int(levels), return_leg=bool(return_leg))
 
     schedule = schedule_for(duration_s)
-    tas_min, tas_max = schedule.tas_mps.min(), schedule.tas_mps.max()
+    tas_min = schedule.tas_mps.min()
     if wind_speed_mps >= 0.9 * tas_min:
         raise PlanInfeasibleError(
             f"wind_speed_mps {wind_speed_mps:g} is too strong to hold position at "
@@ -398,18 +398,30 @@ def plan_maneuver(profile="continuous", cas_min_kt=70.0, cas_max_kt=100.0, radiu
         raise PlanInfeasibleError(
             f"duration {duration_s:g} s is too short to turn 360° in each {where} at "
             f"{bank_max_deg:g}° bank: needs at least {np.ceil(hi):.0f} s")
-    r_turn = float(turn_radius_m(tas_max, bank_max))
-    if radius_m < r_turn + margin_m:
-        raise PlanInfeasibleError(
-            f"radius {radius_m:g} m is below the {np.ceil(r_turn + margin_m):.0f} m turn "
-            f"radius at {cas_max_kt:g} KCAS and {bank_max_deg:g}° bank")
-
+    # Necessary condition: a path whose heading turns 180 deg with turn radius >= r spans at
+    # least 2 r across (the along-track drift of the wind does not change the cross extent),
+    # so each coverage group needs R >= r at the slowest speed of the group.
+    slowest = [min(schedule.tas_mps[a:b + 1].min() for a, b in runs) for runs in schedule.groups]
+    tas_turn = max(slowest)
+    r_turn = float(turn_radius_m(tas_turn, bank_max))
+    too_small = radius_m < r_turn + margin_m
     wind = wind_vector_mps(wind_speed_mps, wind_from_deg)
     problem = _problem(schedule.n_intervals, len(schedule.groups)) if ipopt_options is None \
         else ManeuverProblem(schedule.n_intervals, len(schedule.groups),
                              ipopt_options=ipopt_options)
     kwargs = dict(turn=turn, margin_m=margin_m, heading_margin_rad=heading_margin)
     roll_max = np.radians(roll_dps)
+    if too_small:
+        cas_kt = float(mps_to_kt(tas_turn * np.sqrt(schedule.rho_kgm3 / RHO0_KGM3)))
+        message = (f"radius {radius_m:g} m is below the {np.ceil(r_turn + margin_m):.0f} m turn "
+                   f"radius at {cas_kt:.0f} KCAS and {bank_max_deg:g}° bank")
+        smallest = problem.solve(schedule, radius_m, wind, bank_max, roll_max,
+                                 minimize_radius=True, **kwargs)
+        if smallest.success:
+            need = np.ceil(smallest.radius_m + margin_m)
+            message += (f"; the smallest radius that fits this {profile} maneuver in "
+                        f"{wind_speed_mps:g} m/s wind is {need:.0f} m")
+        raise PlanInfeasibleError(message)
     sol = problem.solve(schedule, radius_m, wind, bank_max, roll_max, **kwargs)
     log.info("plan: %s after %d iterations, %.3f s", sol.message, sol.iterations,
              sol.solve_time_s)
