@@ -13,6 +13,8 @@ import math
 import time
 from pathlib import Path
 
+from estimation.errors import PitotcalError
+
 from .runner import run_cases, run_one, write_table
 
 __all__ = ["STUDY_MODULES", "EXTERNAL_STUDIES", "study_names", "get_study", "run_study", "rerun"]
@@ -48,7 +50,7 @@ def study_names():
 def get_study(name):
     """The `Study` called `name`; ValueError naming the choices otherwise."""
     if name not in STUDY_MODULES:
-        raise ValueError(f"study {name!r} is not one of {', '.join(STUDY_MODULES)}")
+        raise PitotcalError(f"study {name!r} is not one of {', '.join(STUDY_MODULES)}")
     return importlib.import_module(STUDY_MODULES[name]).STUDY
 
 
@@ -80,7 +82,7 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
         ``errors`` (message -> count), ``elapsed_s``, ``files`` and the study's own keys.
     """
     if runs is not None and (int(runs) != runs or runs < 1):
-        raise ValueError(f"runs must be a positive integer, got {runs!r}")
+        raise PitotcalError(f"runs must be a positive integer, got {runs!r}")
     out = Path(out_dir)
     if name in EXTERNAL_STUDIES and name not in STUDY_MODULES:
         return _run_external(name, out, runs, seed)

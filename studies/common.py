@@ -17,7 +17,7 @@ from estimation.models import get_model, qc_from_qci_pa
 from estimation.units import RHO0_KGM3, kt_to_mps, mps_to_kt
 
 __all__ = ["T2_PLAN", "get_plan", "fly", "identify_flight", "score", "true_delta_v_kt",
-           "wrap_deg", "first_seconds", "run_fly_identify", "Study", "ok_rows", "column",
+           "wrap_deg", "first_seconds", "truth_for", "run_fly_identify", "Study", "ok_rows", "column",
            "group", "stats", "new_figure", "save"]
 
 # The reference paper's T-2 case (section IV): continuous 70-100 KCAS, 0.5 nm, 800 ft, 240 s.
@@ -39,7 +39,7 @@ def get_plan(**plan_kwargs):
 
 @functools.lru_cache(maxsize=32)
 def _plan_cached(key):
-    from maneuvers.planner import plan_maneuver
+    from maneuvers import plan_maneuver
     return plan_maneuver(**json.loads(key))
 
 
@@ -50,17 +50,34 @@ def fly(plan_kwargs=None, sim_kwargs=None, seed=0):
 
 @functools.lru_cache(maxsize=4)
 def _fly_cached(plan_key, sim_key, seed):
-    from maneuvers.simulator import simulate
+    from maneuvers import simulate
     sim = json.loads(sim_key)
     for name in ("k", "wind_drift_mps2"):      # JSON turned tuples into lists
         if name in sim:
             sim[name] = tuple(sim[name])
-    return simulate(_plan_cached(plan_key), seed=seed, **sim)
+    # keep_history: the wind flown through, to give a part of the flight its own truth
+    return simulate(_plan_cached(plan_key), seed=seed, keep_history=True, **sim)
+
+
+def truth_for(truth, flight):
+    """The truth of the samples in `flight` (a part of the simulated one): the wind becomes
+    the time-average over those samples' times."""
+    hist = truth.get("history")
+    if not hist or "wind_n_mps" not in hist:
+        return truth
+    t = np.asarray(hist["time_s"])
+    pick = np.isin(np.round(t, 6), np.round(flight.time_s, 6))
+    if not pick.any():
+        return truth
+    wn, we = np.mean(np.asarray(hist["wind_n_mps"])[pick]), np.mean(np.asarray(hist["wind_e_mps"])[pick])
+    params = {**truth["parameters"], "wind_speed_mps": float(np.hypot(wn, we)),
+              "wind_from_deg": float(np.degrees(np.arctan2(-we, -wn)) % 360.0)}
+    return {**truth, "parameters": params}
 
 
 def identify_flight(flight, model="inverse"):
     """`estimation.identify` with the study defaults (GPS noise estimated from the data)."""
-    from estimation.identify import identify
+    from estimation import identify
     return identify(flight, model=model)
 
 
@@ -129,7 +146,7 @@ def run_fly_identify(seed, plan=None, sim=None, model="inverse", seconds=None):
     """Plan, fly and identify one flight (optionally only its first `seconds`); the scored row."""
     flight, truth = fly(plan, sim, seed)
     used = first_seconds(flight, seconds)
-    return score(identify_flight(used, model), truth, used)
+    return score(identify_flight(used, model), truth_for(truth, used), used)
 
 
 # --- the shape of a study, and small helpers for summaries and figures ----------------------

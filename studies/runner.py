@@ -25,6 +25,8 @@ import os
 import time
 import traceback
 
+from estimation.errors import PitotcalError
+
 __all__ = ["SERIAL_BELOW", "run_cases", "run_one", "case_seed", "write_table", "read_table",
            "echo_task"]
 
@@ -66,9 +68,9 @@ def run_cases(task, cases, *, base_seed=0, workers=None, scheduler=None, progres
     """
     cases = [dict(c) for c in cases]
     if workers is not None and (int(workers) != workers or workers < 0):
-        raise ValueError(f"workers must be an integer >= 0, got {workers!r}")
+        raise PitotcalError(f"workers must be an integer >= 0, got {workers!r}")
     if not callable(task):
-        raise ValueError("task must be callable")
+        raise PitotcalError("task must be callable")
     progress = progress or _log_progress
     total = len(cases)
     jobs = [(task, case, i, case_seed(base_seed, i, case)) for i, case in enumerate(cases)]
@@ -87,7 +89,7 @@ def run_one(task, cases, run_index, base_seed=0):
     """Repeat run `run_index` alone, in process; the same rows it gave inside the study."""
     cases = list(cases)
     if not 0 <= run_index < len(cases):
-        raise ValueError(f"run index {run_index} is outside 0..{len(cases) - 1}")
+        raise PitotcalError(f"run index {run_index} is outside 0..{len(cases) - 1}")
     case = dict(cases[run_index])
     return _flatten([_call(task, case, run_index, case_seed(base_seed, run_index, case))])
 
@@ -179,9 +181,11 @@ def write_table(rows, path):
 
 
 def read_table(path):
-    """Read a table written by `write_table`: numbers as float, empty cells as NaN."""
+    """Read a table written by `write_table`: numbers as float, empty cells as NaN (the
+    ``error`` column stays text: "" for a run that succeeded)."""
     with open(path, newline="") as fh:
-        return [{k: _parse(v) for k, v in row.items()} for row in csv.DictReader(fh)]
+        return [{k: (v if k == "error" else _parse(v)) for k, v in row.items()}
+                for row in csv.DictReader(fh)]
 
 
 def _cell(value):

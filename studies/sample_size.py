@@ -9,7 +9,7 @@ samples come from each speed: N = 10,000 is a dwell of 100 s at each airspeed.
 import numpy as np
 
 from .common import (Study, column, fly, group, identify_flight, new_figure, ok_rows, save,
-                     score, stats)
+                     score, stats, truth_for)
 
 __all__ = ["STUDY", "SAMPLE_COUNTS", "S2_PLAN"]
 
@@ -26,7 +26,7 @@ def task(seed, n_samples_used):
     mask = np.zeros(flight.n, dtype=bool)
     mask[start:start + n] = True
     used = flight.select(mask)
-    row = score(identify_flight(used), truth, used)
+    row = score(identify_flight(used), truth_for(truth, used), used)
     row["window_s"] = float(used.time_s[-1] - used.time_s[0])
     return row
 

@@ -1,0 +1,170 @@
+"""`pitotcal demo`: the whole job on the paper's T-2 case, with known truth to compare against.
+
+Plan the continuous 70-100 KCAS maneuver (0.5 nm = 926 m radius, 800 ft = 244 m, 240 s, 30°
+bank, 5 m/s wind from 270°), fly it in the simulator (light turbulence, realistic sensors: 50 Hz
+transducer with 0.5 Pa noise, 5 Hz GPS with 0.05 m/s noise), identify the inverse+ model and
+the wind, and write everything into one folder.
+"""
+
+import json
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from estimation.errors import PitotcalError
+
+from .common import T2_PLAN, new_figure, save, true_delta_v_kt
+
+__all__ = ["DemoResult", "run_demo", "format_table", "DEMO_SIM"]
+
+log = logging.getLogger(__name__)
+
+# "Light turbulence, realistic sensors" (issue 4): the simulator's defaults, written out here
+# so the demo does not change silently when they do.
+DEMO_SIM = {"model": "inverse", "k": (0.02, -15.0), "turbulence_mps": 0.5, "rate_hz": 50.0,
+            "qc_noise_pa": 0.5, "gps_rate_hz": 5.0, "gps_noise_mps": 0.05}
+
+
+@dataclass(frozen=True)
+class DemoResult:
+    """What `run_demo` did.
+
+    Attributes
+    ----------
+    out_dir : Path
+    files : dict
+        Role -> path: ``plan_csv``, ``flight_csv``, ``truth_json``, ``result_json``,
+        ``plan_png``, ``calibration_png``, ``residuals_png``.
+    table : list of dict
+        Rows {vi_kt, dv_kt, dv_2sigma_kt, dv_true_kt} over the flown range.
+    result : estimation.result.IdentificationResult
+    truth : dict
+        The simulator's truth.
+    timing_s : dict
+        Seconds spent planning, simulating, identifying and writing.
+    """
+
+    out_dir: Path
+    files: dict
+    table: list
+    result: object
+    truth: dict
+    timing_s: dict = field(default_factory=dict)
+
+
+def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=240.0, rate_hz=50.0):
+    """Plan, fly and identify the T-2 case; write plan, flight, result and figures to `out_dir`.
+
+    Parameters
+    ----------
+    out_dir : str or Path
+        Folder for the outputs (created when missing).
+    seed : int
+        Simulator seed (the same seed gives the same files).
+    duration_s, rate_hz : float
+        Maneuver length and data rate (shorter or slower only for quick checks).
+
+    Returns
+    -------
+    DemoResult
+    """
+    import time
+
+    from estimation import identify, write_flight_csv
+    from maneuvers import plan_maneuver, simulate, write_plan, write_truth_json
+
+    if duration_s <= 0 or rate_hz <= 0:
+        raise PitotcalError("duration_s and rate_hz must be > 0")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    clock = {}
+    t0 = time.perf_counter()
+    plan = plan_maneuver(**{**T2_PLAN, "duration_s": float(duration_s)})
+    clock["plan"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    flight, truth = simulate(plan, seed=seed, **{**DEMO_SIM, "rate_hz": float(rate_hz)})
+    clock["simulate"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    result = identify(flight, model="inverse")
+    clock["identify"] = time.perf_counter() - t0
+
+    t0 = time.perf_counter()
+    files = {"plan_csv": out / "plan.csv", "flight_csv": out / "flight.csv",
+             "truth_json": out / "flight.truth.json", "result_json": out / "result.json"}
+    write_plan(plan, files["plan_csv"])
+    write_flight_csv(flight, files["flight_csv"], comments={"source": "pitotcal demo",
+                                                             "seed": seed})
+    write_truth_json(truth, files["truth_json"])
+    table = _table(result, truth)
+    doc = result.to_dict()
+    doc["truth"] = {"model": truth["model"], "parameters": truth["parameters"]}
+    doc["demo_table"] = table
+    files["result_json"].write_text(json.dumps(doc, indent=2, default=_json_default) + "\n")
+    files["plan_png"] = _plan_figure(plan, out)
+    files["calibration_png"] = out / "calibration.png"
+    result.plot(files["calibration_png"])
+    files["residuals_png"] = _residual_figure(result, out)
+    clock["write"] = time.perf_counter() - t0
+    return DemoResult(out, {k: Path(v) for k, v in files.items()}, table, result, truth,
+                      {k: round(v, 3) for k, v in clock.items()})
+
+
+def _table(result, truth):
+    """Correction rows of the result with the truth ΔV beside each."""
+    rows = result.correction_table()
+    model = truth["model"]
+    from estimation.models import get_model
+    k = [truth["parameters"][p] for p in get_model(model).params]
+    vi = np.array([r["vi_kt"] for r in rows], dtype=float)
+    dv_true = true_delta_v_kt(model, k, vi)
+    return [{"vi_kt": float(r["vi_kt"]), "dv_kt": float(r["dv_kt"]),
+             "dv_2sigma_kt": float(r["dv_2sigma_kt"]), "dv_true_kt": float(t)}
+            for r, t in zip(rows, dv_true)]
+
+
+def format_table(table, every_kt=5.0):
+    """The calibration table as text: KCAS (indicated), ΔV, ±2σ, truth ΔV, inside?"""
+    lines = ["  V_i kt   ΔV kt    ±2σ kt   truth ΔV kt   inside ±2σ",
+             "  ------   ------   ------   -----------   ----------"]
+    last = -np.inf
+    for i, row in enumerate(table):
+        if row["vi_kt"] - last < every_kt - 1e-6 and i != len(table) - 1:
+            continue
+        last = row["vi_kt"]
+        inside = abs(row["dv_kt"] - row["dv_true_kt"]) <= row["dv_2sigma_kt"]
+        lines.append(f"  {row['vi_kt']:6.1f}   {row['dv_kt']:+6.3f}   {row['dv_2sigma_kt']:6.3f}"
+                     f"   {row['dv_true_kt']:+11.3f}   {'yes' if inside else 'NO':>10}")
+    return "\n".join(lines)
+
+
+def _plan_figure(plan, out):
+    """The planner's plan figure (ground track, CAS schedule, q histogram)."""
+    from maneuvers import plot_plan
+    path = out / "plan.png"
+    plot_plan(plan, path)
+    return path
+
+
+def _residual_figure(result, out):
+    """Output residuals vs time and their histogram (white? Gaussian? drifting?)."""
+    fig, ax = new_figure(1, 2, size=(4.8, 3.6))
+    ax[0, 0].plot(result.time_s, result.residuals_pa, ",", alpha=0.6)
+    ax[0, 0].set_xlabel("time, s")
+    ax[0, 0].set_ylabel("q_ci residual, Pa")
+    ax[0, 0].set_title(f"residual rms {result.noise_std_pa:.2f} Pa, N = {result.n_samples}")
+    ax[0, 1].hist(result.residuals_pa, bins=60, density=True, alpha=0.7)
+    x = np.linspace(*ax[0, 1].get_xlim(), 200)
+    s = max(float(result.noise_std_pa), 1e-9)
+    ax[0, 1].plot(x, np.exp(-0.5 * (x / s) ** 2) / (s * np.sqrt(2 * np.pi)), "k-", lw=1)
+    ax[0, 1].set_xlabel("q_ci residual, Pa")
+    return Path(save(fig, out, "residuals.png"))
+
+
+def _json_default(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    return str(value)
