@@ -250,8 +250,12 @@ def _plot(path, summary):
     axes[1].set_ylabel("wind vector, m/s")
     axes[2].set_ylabel("fraction of truths inside stated 2σ")
     axes[2].set_ylim(-0.02, 1.02)
+    from matplotlib.ticker import NullFormatter, ScalarFormatter
     for ax in axes:
         ax.set_xscale("log")
+        ax.set_xticks(summary["times_s"])
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("flight time used T, s")
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_yscale("log")
