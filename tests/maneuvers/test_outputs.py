@@ -1,0 +1,103 @@
+"""Plan outputs: plan CSV round trip, pilot card, auto-throttle setpoints, figures, the CLI."""
+
+import numpy as np
+import pytest
+
+from estimation.units import kt_to_mps
+from maneuvers.outputs import (autothrottle_setpoints, output_paths, pilot_card_text,
+                               write_plan_outputs)
+from maneuvers.plan import PLAN_COLUMNS, read_plan
+from maneuvers.planner import plan_maneuver
+from pitotcal.cli import main
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.fixture(scope="module", params=["continuous", "step-pause"])
+def plan(request):
+    return plan_maneuver(request.param)
+
+
+def test_plan_csv_round_trip(plan, tmp_path):
+    paths = write_plan_outputs(plan, tmp_path / "plan.csv", figures=False)
+    header = [line for line in paths["plan"].read_text().splitlines()
+              if not line.startswith("#")][0]
+    assert header.split(",") == list(PLAN_COLUMNS)
+    back = read_plan(paths["plan"])
+    for name in PLAN_COLUMNS:
+        assert np.allclose(back.column(name), plan.column(name), rtol=1e-5, atol=1e-3), name
+    assert back.settings == plan.settings
+
+
+def test_autothrottle_setpoints(plan, tmp_path):
+    sp = autothrottle_setpoints(plan)
+    assert np.allclose(sp["cas_cmd_kt"] * kt_to_mps(1.0), plan.cas_mps)
+    # the feed-forward integrates to the commanded true airspeed
+    tas = plan.tas_mps[0] + np.r_[0.0, np.cumsum(sp["accel_ff_mps2"][:-1] * np.diff(sp["time_s"]))]
+    assert np.allclose(tas, plan.tas_mps, atol=1e-9)
+    assert np.max(np.abs(sp["accel_ff_mps2"])) <= plan.settings["accel_max_mps2"] + 1e-9
+    resampled = autothrottle_setpoints(plan, rate_hz=10.0)
+    assert np.allclose(np.diff(resampled["time_s"]), 0.1)
+    paths = write_plan_outputs(plan, tmp_path / "p.csv", figures=False)
+    lines = paths["autothrottle"].read_text().splitlines()
+    header = [line for line in lines if not line.startswith("#")][0]
+    assert header == "time_s,cas_cmd_kt,cas_cmd_mps,tas_cmd_mps,accel_ff_mps2"
+    assert len(lines) - lines.index(header) - 1 == plan.n
+
+
+def test_pilot_card_text(plan):
+    text = pilot_card_text(plan)
+    assert "70-100 KCAS" in text and "801 ft +-50 ft" in text and "3038 ft" in text
+    rows = [line for line in text.splitlines() if line[:5].strip().count(":") == 1
+            and "±5" in line]
+    assert rows[0].split()[:3] == ["0:00", "70.0±5", rows[0].split()[2]]
+    assert rows[-1].split()[1] == "100.0±5" and rows[-1].endswith("end")
+    assert all(" ft " in row for row in rows)
+    if plan.settings["profile"] == "step-pause":
+        assert "accelerate to 81" in text and "hold" in text
+    else:
+        assert "kt/s" in text
+
+
+def test_figures_are_pngs(tmp_path):
+    plan = plan_maneuver("two-speed")
+    paths = write_plan_outputs(plan, tmp_path / "two.csv")
+    assert set(paths) == {"plan", "card_txt", "card_png", "autothrottle", "figure"}
+    for key in ("card_png", "figure"):
+        data = paths[key].read_bytes()
+        assert data.startswith(PNG_MAGIC) and len(data) > 20_000
+
+
+def test_output_paths_beside_the_plan(tmp_path):
+    paths = output_paths(tmp_path / "T2.csv")
+    assert paths["card_txt"] == tmp_path / "T2.card.txt"
+    assert paths["autothrottle"] == tmp_path / "T2.autothrottle.csv"
+    assert paths["figure"] == tmp_path / "T2.png"
+
+
+def test_cli_plan_writes_files(tmp_path, capsys):
+    out = tmp_path / "plan.csv"
+    assert main(["plan", "--profile", "step-pause", "--no-figures", "-o", str(out)]) == 0
+    stdout = capsys.readouterr().out
+    assert "step-pause plan: 240 s" in stdout and str(out) in stdout
+    plan = read_plan(out)
+    assert plan.settings["profile"] == "step-pause" and plan.settings["radius_m"] == 926.0
+    assert (tmp_path / "plan.card.txt").exists() and (tmp_path / "plan.autothrottle.csv").exists()
+
+
+CLI_REFUSALS = [
+    (["--radius-m", "150"], "radius 150 m is below the 399 m turn radius at 91 KCAS and 30° bank"),
+    (["--cas-min-kt", "100", "--cas-max-kt", "90"], "cas_min_kt 100 must be below cas_max_kt 90"),
+    (["--duration-s", "60"], "duration 60 s is too short to turn 360° in each third"),
+    (["--profile", "two-speed", "--duration-s", "5"], "acceleration limit: needs at least"),
+]
+
+
+@pytest.mark.parametrize("argv, message", CLI_REFUSALS)
+def test_cli_refuses_infeasible_requests(argv, message, tmp_path, capsys):
+    out = tmp_path / "plan.csv"
+    assert main(["plan", *argv, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pitotcal plan: ") and message in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert not out.exists()
