@@ -92,7 +92,7 @@ def lag_weights(lag, window="bartlett"):
     return np.where(x <= 0.5, 1 - 6 * x ** 2 + 6 * x ** 3, 2 * (1 - x) ** 3)
 
 
-def colored_covariance(jac, residuals, *, window="bartlett", lag=None):
+def colored_covariance(jac, residuals, *, window="exponential", lag=None):
     """Covariance corrected for colored residuals (Morelli & Klein 1997; SIDPAC `colores`).
 
     Parameters
@@ -100,10 +100,12 @@ def colored_covariance(jac, residuals, *, window="bartlett", lag=None):
     jac : ndarray, shape (N, p)
         Output sensitivities S = dr/dtheta at the optimum.
     residuals : ndarray, shape (N,)
-    window : {"bartlett", "parzen"}
-        Lag window applied to the residual autocovariance.
+    window : {"exponential", "bartlett", "parzen"}
+        How R_vv is formed: "exponential" (default) models it as white noise plus an
+        exponential decay fitted to the sample autocovariance at short lags; "bartlett" and
+        "parzen" taper the sample autocovariance with that lag window.
     lag : int, optional
-        Truncation lag, samples; Andrews' AR(1) plug-in on the residuals when None.
+        Truncation lag of "bartlett"/"parzen", samples; Andrews' AR(1) plug-in when None.
 
     Returns
     -------
@@ -118,8 +120,16 @@ def colored_covariance(jac, residuals, *, window="bartlett", lag=None):
     and R cancels: Cov = (S^T S)^-1 S^T (H S) (S^T S)^-1 with H the Toeplitz matrix of
     h(k) = w(k) R_vv(k). H S is a convolution of each sensitivity column with h, done by FFT
     (overlap-add): O(N log N), never the N x N double sum. Summing every lag of a sample
-    autocovariance is degenerate (it collapses toward zero for zero-mean residuals), hence the
-    lag window w with a data-driven truncation lag. Lags count samples of the data as given;
+    autocovariance is degenerate (it collapses toward zero for zero-mean residuals), so R_vv
+    needs a model or a lag window. Measured by Monte Carlo (turbulence 0.5 m/s + 5 Hz held
+    GPS, N = 16,000, inverse model, 40 runs): Bartlett with Andrews' plug-in lag covered 86%
+    of truths at 2 sigma (k1, k2 only 75%: its taper underestimates a slow decay, and long-lag
+    sample estimates are biased low by the fit), the exponential model 93%; plain 7.5%.
+    The exponential model: R(0) = sample variance; R(k) = A a^k for k >= 1, with log A and
+    log a fitted to the sample R(1..k*) (k* where it falls below 0.3 R(1)), summed to
+    a^k = 1e-4; white when R(1) is within 3/sqrt(N) R(0) of zero. It is a valid (positive
+    definite) autocovariance, so the corrected covariance stays positive definite.
+    Lags count samples of the data as given;
     time gaps are treated as adjacent samples (`OutputErrorProblem` warns when gaps are not
     rare). With white residuals this reduces to the plain s^2 (S^T S)^-1.
     """
@@ -127,11 +137,14 @@ def colored_covariance(jac, residuals, *, window="bartlett", lag=None):
 
     n, p = jac.shape
     a = 0.0
-    if lag is None:
-        lag, a = truncation_lag(residuals, window)
-    lag = int(min(lag, n - 1))
-    acov = residual_acf(residuals, lag) * n / max(n - p, 1)
-    h = lag_weights(lag, window) * acov
+    if window == "exponential":
+        h, lag, a = _exponential_acov(residuals, p)
+    else:
+        if lag is None:
+            lag, a = truncation_lag(residuals, window)
+        lag = int(min(lag, n - 1))
+        acov = residual_acf(residuals, lag) * n / max(n - p, 1)
+        h = lag_weights(lag, window) * acov
     kernel = np.concatenate([h[:0:-1], h])
     hs = oaconvolve(jac, kernel[:, None], mode="same", axes=0)
     m_inv = _inv_sym(jac.T @ jac)
@@ -161,6 +174,27 @@ def to_reported(n_coef, theta, cov):
     jac[n_coef + 1, n_coef:] = np.degrees([-we / s2, wn / s2])
     params = np.concatenate([theta[:n_coef], [speed, from_deg]])
     return params, jac @ cov @ jac.T
+
+
+def _exponential_acov(residuals, p):
+    """Residual autocovariance modelled as white + exponential decay, fitted at short lags."""
+    n = residuals.size
+    kmax = int(min(n // 4, 20000))
+    acov = residual_acf(residuals, kmax) * n / max(n - p, 1)
+    # lag-1 correlation within sampling noise of zero (~1/sqrt(N)): white residuals
+    if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
+        return acov[:1], 0, float(acov[1] / acov[0])
+    below = np.nonzero(acov[1:] < 0.3 * acov[1])[0]
+    kstar = int(below[0]) + 1 if below.size else kmax
+    kstar = max(kstar, 3)
+    k = np.arange(1, kstar + 1)
+    slope, icpt = np.polyfit(k, np.log(np.maximum(acov[1:kstar + 1], 1e-300)), 1)
+    a = float(np.clip(np.exp(slope), 0.0, 0.99999))
+    amp = float(np.exp(icpt))
+    lag = int(min(np.ceil(np.log(1e-4) / np.log(max(a, 1e-12))), n - 1, kmax * 4))
+    h = amp * a ** np.arange(lag + 1)
+    h[0] = max(acov[0], amp)
+    return h, lag, a
 
 
 def _inv_sym(m):
