@@ -393,36 +393,44 @@ def _parse_body(path, name, header_line, columns, use):
 
 
 def _parse_slow(path, header_line, columns, use, index):
+    """Blocks of rows through np.loadtxt; only a block that fails is parsed cell by cell."""
     with _text(path) as f:
         lines = f.read().splitlines()[header_line:]
-    line_no, fields = [], []
-    for k, line in enumerate(lines):
-        # blank lines are skipped as np.loadtxt does; a '#' line inside the data is a bad row
-        if line.strip():
-            line_no.append(header_line + 1 + k)
-            fields.append(line.split(","))
-    n, width = len(fields), len(columns)
-    data = np.full((n, len(use)), np.nan)
+    # blank lines are skipped as np.loadtxt does; a '#' line inside the data is a bad row
+    line_no = [header_line + 1 + k for k, line in enumerate(lines) if line.strip()]
+    lines = [lines[k - header_line - 1] for k in line_no]
+    data = np.full((len(lines), len(use)), np.nan)
     bad = {}
-    for j, (c, i) in enumerate(zip(use, index)):
-        cells = [f[i] if i < len(f) else None for f in fields]
+    for lo in range(0, len(lines), _BLOCK_ROWS):
+        block = lines[lo:lo + _BLOCK_ROWS]
         try:
-            data[:, j] = np.array(cells, dtype=float) if None not in cells else 1 / 0
-            continue
-        except (ValueError, TypeError, ZeroDivisionError):
-            pass
-        for r, cell in enumerate(cells):
-            if cell is None:
-                problem = f"short row ({len(fields[r])} fields, header has {width})"
-            else:
-                try:
-                    data[r, j] = float(cell)
-                    continue
-                except ValueError:
-                    problem = "empty cell" if not cell.strip() else \
-                        f"non-numeric value {cell.strip()[:20]!r}"
-            bad.setdefault(r, (c, problem))
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                data[lo:lo + len(block)] = np.loadtxt(block, delimiter=",", usecols=index,
+                                                      ndmin=2, comments=None, dtype=float)
+        except ValueError:
+            _parse_cells(block, lo, len(columns), use, index, data, bad)
     return _Table(path, header_line, data, bad, np.array(line_no))
+
+
+_BLOCK_ROWS = 10000
+
+
+def _parse_cells(block, lo, width, use, index, data, bad):
+    """Cell-by-cell parse of rows lo.. (a block with a bad cell); first problem per row."""
+    for k, line in enumerate(block):
+        fields = line.split(",")
+        r = lo + k
+        for j, (c, i) in enumerate(zip(use, index)):
+            if i >= len(fields):
+                bad.setdefault(r, (c, f"short row ({len(fields)} fields, header has {width})"))
+                continue
+            cell = fields[i].strip()
+            try:
+                data[r, j] = float(cell)
+            except ValueError:
+                problem = f"non-numeric value {cell[:20]!r}" if cell else "empty cell"
+                bad.setdefault(r, (c, problem))
 
 
 def _data_line_numbers(path, header_line):
