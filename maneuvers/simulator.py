@@ -27,10 +27,10 @@ from maneuvers.turbulence import dryden_gusts, dryden_scales
 
 __all__ = ["simulate", "write_truth_json", "truth_path_for", "GUIDANCE_GAINS"]
 
-# Lateral guidance: desired ground velocity = plan's + K_pos * position error (1/s); heading
-# loop K_psi (1/s). K_pos is slow (time constant 30 s) so turbulence does not make the bank busy;
-# K_psi keeps a 10 deg heading error below a 20 deg bank correction at 45 m/s.
-GUIDANCE_GAINS = {"k_pos_per_s": 1.0 / 30.0, "k_psi_per_s": 0.4, "k_alt_per_s": 0.2}
+# Lateral guidance: desired ground track = the path's direction + K_pos * distance to the path
+# (1/s); heading loop K_psi (1/s). K_pos is slow (time constant 20 s) so turbulence does not make
+# the bank busy; K_psi keeps a 10 deg heading error below a 20 deg bank correction at 45 m/s.
+GUIDANCE_GAINS = {"k_pos_per_s": 1.0 / 20.0, "k_psi_per_s": 0.4, "k_alt_per_s": 0.2}
 
 
 def _wind_vector(speed_mps, from_deg):
@@ -222,6 +222,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     bank = math.radians(float(ref["bank_deg"][0]))
     thrust = d_coef * x[4] ** 2 + tdot_r[0]
     integ = 0.0
+    j, last = 0, n - 1
     two_pi, pi = 2.0 * math.pi, math.pi
     cos, sin, atan, atan2 = math.cos, math.sin, math.atan, math.atan2
     drift_n, drift_e = drift
@@ -232,11 +233,27 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
         wn = wnp_l[i] + cpsi * ug_l[i] - spsi * vg_l[i]      # v_g points to the right wing
         we = wep_l[i] + spsi * ug_l[i] + cpsi * vg_l[i]
         rows.append((north, east, alt, psi, v, bank, wn, we))
-        # lateral guidance (the autopilot knows the process wind, not the gusts)
-        an = vgn_l[i] + k_pos * (nr[i] - north) - wnp_l[i]
-        ae = vge_l[i] + k_pos * (er[i] - east) - wep_l[i]
-        dpsi = (atan2(ae, an) - psi + pi) % two_pi - pi
-        bank_cmd = atan(v * (pdff_l[i] + k_psi * dpsi) / G0_MPS2)
+        # Lateral guidance follows the plan's path, not its clock: in another wind the ground
+        # speed differs and a time-indexed reference would be chased across the circle. The
+        # reference point j slides forward along the path to the nearest point.
+        d_j = (nr[j] - north) ** 2 + (er[j] - east) ** 2
+        while j < last:
+            d_next = (nr[j + 1] - north) ** 2 + (er[j + 1] - east) ** 2
+            if d_next > d_j:
+                break
+            j, d_j = j + 1, d_next
+        # desired ground track: the path's direction plus a pull toward it ...
+        gn = vgn_l[j] + k_pos * (nr[j] - north)
+        ge = vge_l[j] + k_pos * (er[j] - east)
+        g_norm = math.hypot(gn, ge) or 1.0
+        gn, ge = gn / g_norm, ge / g_norm
+        # ... solved through the wind triangle (the autopilot knows the process wind, not the
+        # gusts) for the heading whose air velocity gives that track.
+        wn_c, we_c = wnp_l[i], wep_l[i]
+        dw = gn * wn_c + ge * we_c
+        gs = dw + math.sqrt(max(v * v - wn_c * wn_c - we_c * we_c + dw * dw, 0.0))
+        dpsi = (atan2(gs * ge - we_c, gs * gn - wn_c) - psi + pi) % two_pi - pi
+        bank_cmd = atan(v * (pdff_l[j] + k_psi * dpsi) / G0_MPS2)
         bank_cmd = min(max(bank_cmd, -bank_max), bank_max)
         bank += min(max(bank_cmd - bank, -dbank_max), dbank_max)
         # auto-throttle on the CAS schedule (same CAS/TAS ratio at the same altitude)

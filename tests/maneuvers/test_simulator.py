@@ -1,0 +1,289 @@
+"""Flight simulator: determinism, truth, tracking, sensors, CLI, and identification back to truth."""
+
+import json
+
+import numpy as np
+import pytest
+
+from estimation.errors import PitotcalError
+from estimation.units import G0_MPS2, RHO0_KGM3, isa_density_kgm3, kt_to_mps, mps_to_kt
+from maneuvers.plan import Plan, write_plan
+from maneuvers.sensors import first_order_lag, gps_velocity_sensor, impact_pressure_sensor
+from maneuvers.simulator import simulate, truth_path_for, write_truth_json
+
+
+def circle_plan(duration_s=240.0, cas_kt=(70.0, 100.0), radius_m=600.0, altitude_m=244.0,
+                wind_speed_mps=5.0, wind_from_deg=270.0, step_s=0.5):
+    """A hand-made plan: a ground circle about the centre flown in the wind, CAS uniform in q.
+
+    (Independent of the planner, so the simulator tests do not depend on it.)
+    """
+    t = np.arange(0.0, duration_s + 1e-9, step_s)
+    rho = float(isa_density_kgm3(altitude_m))
+    qlo, qhi = (0.5 * RHO0_KGM3 * kt_to_mps(v) ** 2 for v in cas_kt)
+    qc = qlo + (qhi - qlo) * t / duration_s
+    cas = np.sqrt(2 * qc / RHO0_KGM3)
+    tas = cas * np.sqrt(RHO0_KGM3 / rho)
+    a = np.radians(wind_from_deg)
+    w = np.array([-wind_speed_mps * np.cos(a), -wind_speed_mps * np.sin(a)])
+
+    def ground_speed(theta, v):
+        tau = np.array([-np.sin(theta), np.cos(theta)])
+        tw = tau @ w
+        return tw + np.sqrt(v * v - w @ w + tw * tw)
+
+    theta = np.zeros(t.size)
+    for i in range(1, t.size):
+        s1 = ground_speed(theta[i - 1], tas[i - 1])
+        s2 = ground_speed(theta[i - 1] + step_s * s1 / radius_m, tas[i])
+        theta[i] = theta[i - 1] + step_s * 0.5 * (s1 + s2) / radius_m
+    s = np.array([ground_speed(th, v) for th, v in zip(theta, tas)])
+    air = s[:, None] * np.column_stack([-np.sin(theta), np.cos(theta)]) - w
+    heading = np.unwrap(np.arctan2(air[:, 1], air[:, 0]))
+    bank = np.degrees(np.arctan(tas * np.gradient(heading, t) / G0_MPS2))
+    settings = {"profile": "test-circle", "cas_min_kt": cas_kt[0], "cas_max_kt": cas_kt[1],
+                "radius_m": radius_m, "altitude_m": altitude_m, "duration_s": duration_s,
+                "bank_max_deg": 30.0, "wind_speed_mps": wind_speed_mps,
+                "wind_from_deg": wind_from_deg}
+    return Plan(time_s=t, north_m=radius_m * np.cos(theta), east_m=radius_m * np.sin(theta),
+                alt_m=np.full(t.size, altitude_m), heading_deg=np.degrees(heading),
+                bank_deg=bank, tas_mps=tas, cas_mps=cas, qc_pa=qc, settings=settings)
+
+
+@pytest.fixture(scope="module")
+def plan():
+    return circle_plan()
+
+
+@pytest.fixture(scope="module")
+def flown(plan):
+    return simulate(plan, seed=11, keep_history=True)
+
+
+# --- determinism and output ------------------------------------------------------------------
+
+def test_same_seed_same_flight_other_seed_differs(plan):
+    a, ta = simulate(plan, seed=5)
+    b, tb = simulate(plan, seed=5)
+    c, _ = simulate(plan, seed=6)
+    for name in ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "gps_vd_mps", "rho_kgm3"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert ta == tb
+    assert not np.array_equal(a.qci_pa, c.qci_pa)
+
+
+def test_flight_columns_rate_and_density(plan, flown):
+    flight, truth = flown
+    assert flight.n == 240 * 50 + 1
+    np.testing.assert_allclose(np.diff(flight.time_s), 0.02)
+    np.testing.assert_allclose(flight.rho_kgm3, isa_density_kgm3(244.0), rtol=1e-6)
+    np.testing.assert_allclose(flight.alt_m, 244.0, atol=0.5)
+    assert truth["seed"] == 11 and truth["model"] == "inverse"
+    assert set(truth["options"]) >= {"turbulence_mps", "gps_rate_hz", "qc_noise_pa", "k",
+                                     "wind_drift_mps2", "gps_latency_s", "pneumatic_lag_s"}
+
+
+# --- truth -------------------------------------------------------------------------------------
+
+def test_truth_wind_is_time_average_of_wind_flown(flown):
+    flight, truth = flown
+    h = truth["history"]
+    # Reconstruct the wind from the true ground velocity minus the air velocity.
+    wn = h["gps_true_mps"][:, 0] - h["tas_mps"] * np.cos(h["heading_rad"])
+    we = h["gps_true_mps"][:, 1] - h["tas_mps"] * np.sin(h["heading_rad"])
+    assert truth["wind_n_mps"] == pytest.approx(wn.mean(), abs=1e-9)
+    assert truth["wind_e_mps"] == pytest.approx(we.mean(), abs=1e-9)
+    speed = np.hypot(wn.mean(), we.mean())
+    assert truth["parameters"]["wind_speed_mps"] == pytest.approx(speed, abs=1e-9)
+    assert truth["parameters"]["wind_from_deg"] == pytest.approx(
+        np.degrees(np.arctan2(-we.mean(), -wn.mean())) % 360, abs=1e-7)
+    # turbulence makes it differ from the process mean, which is kept separately
+    assert truth["wind_mean_process"] == {"speed_mps": 5.0, "from_deg": 270.0,
+                                          "drift_mps2": [0.0, 0.0]}
+    assert truth["parameters"]["wind_speed_mps"] != 5.0
+    assert abs(truth["parameters"]["wind_speed_mps"] - 5.0) < 0.5
+
+
+def test_wind_overrides_and_drift_about_the_middle(plan):
+    _, truth = simulate(plan, seed=2, turbulence_mps=0.0, wind_speed_mps=8.0, wind_from_deg=45.0,
+                        wind_drift_mps2=(0.004, -0.002), keep_history=True)
+    assert truth["parameters"]["wind_speed_mps"] == pytest.approx(8.0, abs=1e-6)
+    assert truth["parameters"]["wind_from_deg"] == pytest.approx(45.0, abs=1e-6)
+    wn = truth["history"]["wind_n_mps"]
+    assert wn[-1] - wn[0] == pytest.approx(0.004 * 240.0, rel=1e-6)
+
+
+def test_write_truth_json_beside_flight(tmp_path, flown):
+    _, truth = flown
+    path = write_truth_json(truth, tmp_path / "f.csv")
+    assert path == tmp_path / "f.truth.json" == truth_path_for(tmp_path / "f.csv")
+    data = json.loads(path.read_text())
+    assert "history" not in data
+    assert data["parameters"]["k1"] == 0.02 and data["parameters"]["k2"] == -15.0
+    assert write_truth_json(truth, tmp_path / "t.json") == tmp_path / "t.json"
+
+
+# --- tracking ----------------------------------------------------------------------------------
+
+def test_tracking_radius_bank_roll_rate_altitude_and_cas(plan, flown):
+    _, truth = flown
+    h = truth["history"]
+    radius = np.hypot(h["north_m"], h["east_m"])
+    assert radius.max() < plan.settings["radius_m"] * 1.05
+    assert np.degrees(np.abs(h["bank_rad"])).max() <= 30.0 + 1e-9
+    roll_rate = np.degrees(np.abs(np.diff(h["bank_rad"]))) / 0.02
+    assert roll_rate.max() <= 10.0 + 1e-6
+    assert np.abs(h["alt_m"] - 244.0).max() < 15.24
+    cas_err = mps_to_kt(h["cas_mps"] - h["cas_ref_mps"])
+    assert np.abs(cas_err).max() < 5.0
+    assert truth["tracking"]["max_cas_error_kt"] == pytest.approx(np.abs(cas_err).max())
+
+
+def test_wrong_wind_still_tracked_approximately(plan):
+    # the plan was made for 5 m/s from 270; fly it in 8 m/s from 200
+    _, truth = simulate(plan, seed=3, wind_speed_mps=8.0, wind_from_deg=200.0)
+    assert truth["tracking"]["max_radius_m"] < plan.settings["radius_m"] * 1.15
+    assert truth["tracking"]["max_cas_error_kt"] < 5.0
+
+
+# --- sensors -----------------------------------------------------------------------------------
+
+def test_quantization_step_visible(plan):
+    flight, _ = simulate(plan, seed=1, qc_quantization_pa=2.0)
+    steps = flight.qci_pa / 2.0
+    np.testing.assert_allclose(steps, np.round(steps), atol=1e-6)
+    assert np.min(np.abs(np.diff(flight.qci_pa))[np.diff(flight.qci_pa) != 0]) == pytest.approx(2.0)
+
+
+def test_pneumatic_lag_delays_a_ramp_by_tau():
+    dt, tau = 0.02, 0.5
+    t = np.arange(0, 20, dt)
+    y = first_order_lag(100.0 + 3.0 * t, dt, tau)
+    assert y[0] == 100.0                                  # starts settled
+    late = t > 10 * tau
+    # delay tau to within one sample (the filter uses the current input: tau - dt/2)
+    np.testing.assert_allclose(y[late], 100.0 + 3.0 * (t[late] - tau), atol=3.0 * dt)
+    step = first_order_lag(np.r_[0.0, np.ones(t.size - 1)], dt, tau)
+    assert step[int(round(tau / dt))] == pytest.approx(1 - np.exp(-1), abs=0.02)
+
+
+def test_lag_in_simulated_flight_shows_as_delay(plan):
+    quiet = dict(turbulence_mps=0.0, qc_noise_pa=0.0, gps_noise_mps=0.0)
+    a, _ = simulate(plan, seed=1, **quiet)
+    b, _ = simulate(plan, seed=1, pneumatic_lag_s=1.0, **quiet)
+    # on the slow ramp the lagged reading equals the unlagged one 1 s earlier
+    lagged, ref = b.qci_pa[1000:], a.qci_pa[1000 - 50:-50]
+    assert np.abs(lagged - ref).max() < 0.3
+    assert np.abs(b.qci_pa[1000:] - a.qci_pa[1000:]).max() > 2.0
+
+
+def test_scale_error_and_bias():
+    qc = np.linspace(800.0, 1600.0, 100)
+    rng = np.random.default_rng(0)
+    base = impact_pressure_sensor(qc, 0.02, rng, model="constant", k=(0.02,))
+    np.testing.assert_allclose(base, 0.98 * qc)
+    got = impact_pressure_sensor(qc, 0.02, rng, model="constant", k=(0.02,), scale_error=0.01,
+                                 bias_pa=3.0)
+    np.testing.assert_allclose(got, 1.01 * 0.98 * qc + 3.0)
+
+
+def test_gps_sample_and_hold_at_5_hz(flown):
+    flight, _ = flown
+    changes = np.flatnonzero(np.diff(flight.gps_vn_mps) != 0) + 1
+    assert changes.size > 1000
+    assert np.all(changes % 10 == 0)                      # 50 Hz / 5 Hz: new value every 10
+    assert np.all(np.diff(changes) == 10)
+
+
+def test_gps_latency_shifts_velocity():
+    t = np.arange(0, 10, 0.02)
+    v = np.column_stack([np.sin(t), np.cos(t)])
+    out = gps_velocity_sensor(t, v, np.random.default_rng(0), rate_hz=0, noise_mps=0.0,
+                              latency_s=0.3)
+    np.testing.assert_allclose(out[15:], v[:-15], atol=1e-12)
+    np.testing.assert_allclose(out[:15], np.tile(v[0], (15, 1)))
+
+
+def test_gps_noise_level():
+    t = np.arange(0, 200, 0.02)
+    out = gps_velocity_sensor(t, np.zeros((t.size, 3)), np.random.default_rng(0), rate_hz=5.0,
+                              noise_mps=0.1)
+    updates = out[::10]
+    assert updates.std() == pytest.approx(0.1, rel=0.05)
+
+
+# --- argument errors ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"model": "cubic"}, "model 'cubic' is not one of"),
+    ({"k": (0.02,)}, "k needs 2 coefficients"),
+    ({"rate_hz": 0.0}, "rate_hz must be > 0"),
+    ({"turbulence_mps": -1.0}, "turbulence_mps must be >= 0"),
+    ({"wind_speed_mps": float("nan")}, "wind_speed_mps must be a finite number"),
+    ({"wind_drift_mps2": (0.0,)}, "wind_drift_mps2 must be"),
+    ({"gps_noise_mps": -0.1}, "gps_noise_mps must be >= 0"),
+    ({"seed": -3}, "seed must be an integer >= 0"),
+    ({"turbulence_length_m": 0.0}, "turbulence_length_m must be > 0"),
+])
+def test_bad_arguments_refused(plan, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        simulate(plan, **kwargs)
+
+
+def test_not_a_plan_refused():
+    with pytest.raises(PitotcalError, match="plan must be a maneuvers.plan.Plan"):
+        simulate({"time_s": [0, 1]})
+
+
+# --- CLI -----------------------------------------------------------------------------------------
+
+def test_cli_writes_flight_and_truth_same_seed_same_file(tmp_path, plan, capsys):
+    from estimation.flight import read_flight
+    from pitotcal.cli import main
+
+    plan_path = write_plan(plan, tmp_path / "plan.csv")
+    for name in ("a.csv", "b.csv"):
+        assert main(["simulate", str(plan_path), "-o", str(tmp_path / name), "--seed", "4",
+                     "--k1", "0.01", "--turbulence-mps", "1.0"]) == 0
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+    truth = json.loads((tmp_path / "a.truth.json").read_text())
+    assert truth["parameters"]["k1"] == 0.01 and truth["options"]["turbulence_mps"] == 1.0
+    flight = read_flight(tmp_path / "a.csv")
+    assert flight.n == 12001 and flight.meta.get("seed") in (4, "4")
+    assert "wrote" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("content, args, match", [
+    ("x,y\n1,2\n", [], "missing column time_s"),
+    (None, [], "cannot read plan"),
+    ("PLAN", ["--model", "cubic"], "--model: model 'cubic'"),
+    ("PLAN", ["--model", "constant", "--k2", "3"], "--k2: model 'constant' has only 1"),
+    ("PLAN", ["--rate-hz", "-5"], "rate_hz must be > 0"),
+])
+def test_cli_bad_input_exit_2_one_line(tmp_path, plan, capsys, content, args, match):
+    from pitotcal.cli import main
+
+    path = tmp_path / "plan.csv"
+    if content == "PLAN":
+        write_plan(plan, path)
+    elif content is not None:
+        path.write_text(content)
+    assert main(["simulate", str(path), "-o", str(tmp_path / "f.csv"), *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and match in err[0] and err[0].startswith("pitotcal simulate:")
+
+
+# --- the default plan identified back to truth ----------------------------------------------------
+
+@pytest.mark.parametrize("profile", ["continuous", "step-pause", "two-speed"])
+def test_default_plan_identified_back_within_3_sigma(profile):
+    planner = pytest.importorskip("maneuvers.planner")
+    identify = pytest.importorskip("estimation.identify").identify
+    plan = planner.plan_maneuver(profile=profile)
+    flight, truth = simulate(plan, seed=0)
+    assert truth["tracking"]["max_cas_error_kt"] < 5.0
+    result = identify(flight, "inverse")
+    true = truth["parameters"]
+    for i, name in enumerate(("k1", "k2", "wind_speed_mps", "wind_from_deg")):
+        z = (result.params[i] - true[name]) / result.std[i]
+        assert abs(z) < 3.0, f"{profile}: {name} {result.params[i]:.4g} vs {true[name]:.4g}, z={z:.2f}"
