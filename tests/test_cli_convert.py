@@ -1,0 +1,86 @@
+"""`pitotcal convert` (INTERFACES §8): log -> flight CSV, exit statuses, one-line errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+from estimation.flight import read_flight_csv
+from logwriters import write_dataflash_bin, write_ulog
+from pitotcal.cli import main
+from synthetic import synthetic_flight
+
+
+@pytest.fixture(scope="module")
+def flight():
+    return synthetic_flight(seed=2, n=2000, rate_hz=10.0, model="constant", k=(0.03,))[0]
+
+
+def test_convert_writes_flight_csv_with_provenance(tmp_path, flight, capsys):
+    log = write_dataflash_bin(tmp_path / "f.bin", flight, gps_invalid=(50.0, 60.0))
+    out = tmp_path / "f.csv"
+    before = log.read_bytes()
+    assert main(["convert", str(log), "-o", str(out), "--oat-c", "20"]) == 0
+    cap = capsys.readouterr()
+    assert "f.bin (ArduPlane V4.1.0 (test), ArduPilot DataFlash binary) -> " in cap.out
+    assert cap.err == ""                      # --oat-c given: no sensor-temperature warning
+    assert log.read_bytes() == before         # the input is never modified
+    got = read_flight_csv(out)
+    assert got.n > 1800 and not np.any((got.time_s > 50.0) & (got.time_s < 60.0))
+    np.testing.assert_allclose(got.rho_kgm3, 97000.0 / (287.05287 * 293.15), rtol=1e-6)
+    meta = got.meta
+    assert meta["source"] == "f.bin" and meta["autopilot"] == "ArduPlane V4.1.0 (test)"
+    assert meta["temperature_source"] == "oat_k=293.15 K given by the user"
+    assert meta["excluded"].startswith("no valid GPS fix: ")
+    assert meta["autopilot_ARSPD_RATIO"] == "2" and meta["converted_by"] == "pitotcal convert"
+
+
+def test_convert_window_and_warning_lines(tmp_path, flight, capsys):
+    log = write_ulog(tmp_path / "f.ulg", flight)
+    out = tmp_path / "w.csv"
+    assert main(["convert", str(log), "-o", str(out), "--start-s", "20", "--end-s", "80"]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["warning: f.ulg: no outside air temperature in the log: density uses "
+                   "differential_pressure.temperature (airspeed sensor), a sensor temperature, "
+                   "not OAT (pass oat_k, or --oat-c)"]
+    t = read_flight_csv(out).time_s
+    assert t[0] >= 20.0 and t[-1] <= 80.0 and t.size == pytest.approx(600, abs=2)
+
+
+def _errors(tmp, data):
+    trunc = tmp / "cut.bin"
+    trunc.write_bytes((data / "ardupilot" / "arduplane_no_airspeed.bin").read_bytes()[:4000])
+    return [
+        (data / "ardupilot" / "arduplane_no_airspeed.bin",
+         "arduplane_no_airspeed.bin: no airspeed data (ARSP) in the log; ARSPD_ENABLE=0"),
+        (data / "px4-ulog" / "sample_log_small.ulg",
+         "sample_log_small.ulg: too little usable airborne data (on the ground throughout?)"),
+        (trunc, "cut.bin: no data messages in the log; truncated or corrupt file?"),
+        (tmp / "flight.xyz", "flight.xyz: unknown log extension '.xyz'"),
+    ]
+
+
+@pytest.mark.parametrize("case", range(4))
+def test_convert_errors_exit_2_with_one_line(case, tmp_path, shared_data, capsys):
+    path, message = _errors(tmp_path, shared_data)[case]
+    assert main(["convert", str(path), "-o", str(tmp_path / "out.csv")]) == 2
+    err = [line for line in capsys.readouterr().err.splitlines()
+           if not line.startswith("warning: ")]
+    assert len(err) == 1 and err[0].startswith(f"pitotcal convert: {message}")
+    assert "Traceback" not in err[0] and not (tmp_path / "out.csv").exists()
+
+
+def test_convert_refuses_to_overwrite_its_input(tmp_path, flight, capsys):
+    log = write_dataflash_bin(tmp_path / "f.bin", flight)
+    assert main(["convert", str(log), "-o", str(log)]) == 2
+    assert "would overwrite the input log" in capsys.readouterr().err
+
+
+def test_identify_reads_the_sitl_log_directly(shared_data, tmp_path, capsys):
+    """INTERFACES §8 done-when: the SITL DataFlash log, calm air, calibrated end to end."""
+    out = tmp_path / "r.json"
+    log = shared_data / "ardupilot" / "arduplane_sitl.log"
+    assert main(["identify", str(log), "--model", "constant", "--json", str(out)]) == 0
+    result = json.loads(out.read_text())
+    assert result["converged"] and result["parameters"]["wind_speed_mps"]["value"] < 1.0
+    assert "sensor temperature, not OAT" in capsys.readouterr().err
