@@ -14,8 +14,8 @@ __all__ = ["identify", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG", "MIN_QCI_SPAN", "M
 log = logging.getLogger(__name__)
 
 MIN_SAMPLES = 50
-# Wind and calibration separate only if the track turns: below half a circle a wind component
-# along the track is indistinguishable from a scale error.
+# Wind and calibration separate only if the track turns: up to half a circle (an out-and-back
+# line included) the wind across the track is indistinguishable from a scale error.
 MIN_TRACK_SPREAD_DEG = 180.0
 # k1 and the second coefficient separate only over a spread of q_ci: (q98 - q2) / median.
 MIN_QCI_SPAN = 0.05
@@ -158,10 +158,10 @@ def track_spread_deg(vn_mps, ve_mps):
 
 def _check_track(flight):
     spread = track_spread_deg(flight.gps_vn_mps, flight.gps_ve_mps)
-    if spread < MIN_TRACK_SPREAD_DEG:
+    if spread <= MIN_TRACK_SPREAD_DEG:
         raise ObservabilityError(
-            f"{flight.source}: the ground track turns through only {spread:.0f} deg (need "
-            f">= {MIN_TRACK_SPREAD_DEG:.0f}): wind and calibration cannot be separated; fly turns")
+            f"{flight.source}: the ground track turns through only {spread:.0f} deg (need more "
+            f"than {MIN_TRACK_SPREAD_DEG:.0f}): wind and calibration cannot be separated; fly turns")
 
 
 def _check_qci_span(flight, model):

@@ -1,0 +1,189 @@
+"""Output-error identification: recovery of known truth, errors, auto selection, non-convergence."""
+
+import numpy as np
+import pytest
+
+from estimation import ObservabilityError, OutputErrorProblem, PitotcalError, identify
+from estimation.errors import FlightDataError
+from estimation.flight import Flight
+from synthetic import synthetic_flight
+
+TRUE_K = {"constant": (0.02,), "linear": (0.02, 2e-5), "inverse": (0.02, -15.0)}
+
+SCENARIOS = {
+    "calm-air": dict(),
+    "turbulence": dict(turbulence_mps=0.5),
+    "gps-5hz-hold": dict(gps_rate_hz=5.0, gps_noise_mps=0.05),
+    "pressure-noise-quantized": dict(qc_noise_pa=1.0, quantization_pa=1.0),
+    "wind-from-0": dict(wind_from_deg=0.0),
+    "wind-from-90": dict(wind_from_deg=90.0),
+    "wind-from-359.9": dict(wind_from_deg=359.9),
+    "no-wind": dict(wind_speed_mps=0.0),
+}
+
+
+def _z(result, truth):
+    """(estimate - truth) / std per reported parameter; direction wrapped, skipped in calm."""
+    z = {}
+    for name, true in truth["parameters"].items():
+        if name == "wind_from_deg" and truth["parameters"]["wind_speed_mps"] < 0.5:
+            continue   # undefined without wind
+        diff = result.value(name) - true
+        if name == "wind_from_deg":
+            diff = (diff + 180.0) % 360.0 - 180.0
+        z[name] = diff / result.stddev(name)
+    return z
+
+
+@pytest.mark.parametrize("model", list(TRUE_K))
+@pytest.mark.parametrize("scenario", list(SCENARIOS))
+def test_recovers_truth_within_3_sigma(model, scenario):
+    flight, truth = synthetic_flight(seed=11, model=model, k=TRUE_K[model], **SCENARIOS[scenario])
+    result = identify(flight, model)
+    assert result.success, result.message
+    z = _z(result, truth)
+    assert all(abs(v) < 3.0 for v in z.values()), z
+    assert result.param_names == tuple(truth["parameters"])
+    assert np.all(np.isfinite(result.covariance)) and np.all(result.std > 0)
+    assert result.residuals_pa.shape == (flight.n,)
+
+
+def test_result_fields_filled():
+    flight, truth = synthetic_flight(seed=3, turbulence_mps=0.5, gps_rate_hz=5.0, gps_noise_mps=0.05)
+    r = identify(flight)
+    assert r.model == "inverse" and r.n_samples == flight.n and r.iterations > 0
+    assert r.message == "Solve_Succeeded"
+    assert r.internal_params.shape == (4,) and r.internal_covariance.shape == (4, 4)
+    assert set(r.timing_s) == {"build", "solve", "covariance"}
+    assert 0.03 < r.gps_noise_std_mps < 0.08                      # estimated from the data
+    assert r.noise_std_pa > 0
+    # colored residuals: the corrected bounds are wider than the plain ones
+    assert np.all(r.std > 1.5 * r.std_plain)
+    # wind internal <-> reported
+    wn, we = r.internal_params[2:]
+    assert r.value("wind_speed_mps") == pytest.approx(np.hypot(wn, we))
+    assert np.allclose(r.correlation, r.correlation.T)
+
+
+def test_problem_is_reusable():
+    problem = OutputErrorProblem("inverse")
+    first = problem.solve(synthetic_flight(seed=1)[0])
+    again = problem.solve(synthetic_flight(seed=2)[0])
+    assert len(problem._built) == 1                   # one build for flights of one length
+    assert first.success and again.success
+    assert first.value("k1") != again.value("k1")
+
+
+def test_auto_picks_true_structure_on_clear_data():
+    for model in ("constant", "inverse", "linear"):
+        flight, _ = synthetic_flight(seed=5, model=model, k=TRUE_K[model])
+        result = identify(flight, "auto")
+        assert result.model == model
+        assert result.criterion.startswith("BIC")
+        assert [c["model"] for c in result.candidates] == ["constant", "linear", "inverse"]
+        assert all(c["bic"] is not None for c in result.candidates)
+
+
+def test_nonconvergence_is_a_result_not_an_exception():
+    flight, _ = synthetic_flight(seed=2, wind_from_deg=90.0)
+    result = identify(flight, ipopt_options={"max_iter": 1})
+    assert not result.success
+    assert result.message == "Maximum_Iterations_Exceeded"
+    assert any("did not converge" in w for w in result.warnings)
+
+
+def _straight(n=2000):
+    flight, _ = synthetic_flight(seed=1, n=n, turns=0.3)
+    return flight
+
+
+def _one_speed():
+    flight, _ = synthetic_flight(seed=1, cas_kt=(85.0, 85.5))
+    return flight
+
+
+def _no_heading_two_legs():
+    """Out and back along one line: 180 deg apart, but nothing across the track."""
+    flight, _ = synthetic_flight(seed=1, turns=0.0)
+    half = flight.n // 2
+    vn = flight.gps_vn_mps.copy()
+    ve = flight.gps_ve_mps.copy()
+    vn[half:], ve[half:] = -vn[half:], -ve[half:]
+    return Flight(flight.time_s, flight.qci_pa, vn, ve, flight.rho_kgm3, source="legs.csv")
+
+
+@pytest.mark.parametrize("make, model, exc, match", [
+    (_straight, "inverse", ObservabilityError, r"turns through only \d+ deg"),
+    (_one_speed, "inverse", ObservabilityError, r"q_ci spans only .* k1 from k2"),
+    (_one_speed, "linear", ObservabilityError, r"q_ci spans only"),
+    (_no_heading_two_legs, "constant", ObservabilityError, r"turns through only 180 deg \(need more than 180\)"),
+    (lambda: _straight(20), "inverse", FlightDataError, r"20 samples; identification needs at least"),
+    (_straight, "quadratic", PitotcalError, r"model 'quadratic' is not one of constant, linear, inverse, auto"),
+])
+def test_bad_input_raises(make, model, exc, match):
+    with pytest.raises(exc, match=match):
+        identify(make(), model)
+
+
+def test_option_errors():
+    flight, _ = synthetic_flight(seed=1, n=2000)
+    with pytest.raises(PitotcalError, match="gps_noise_std_mps must be"):
+        identify(flight, gps_noise_std_mps=-1.0)
+    with pytest.raises(PitotcalError, match="ipopt_options must be a dict"):
+        identify(flight, ipopt_options=[("max_iter", 3)])
+
+
+def test_nan_is_a_flight_data_error():
+    flight, _ = synthetic_flight(seed=1, n=2000)
+    qci = flight.qci_pa.copy()
+    qci[41] = np.nan
+    bad = Flight(flight.time_s, qci, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3, source="f.csv")
+    with pytest.raises(FlightDataError, match=r"f.csv: qci_pa, row 42: not finite"):
+        identify(bad)
+
+
+def test_near_singular_information_is_an_observability_error():
+    # a span just above the pre-check: k1 and k2 correlate beyond MAX_CORRELATION
+    flight, _ = synthetic_flight(seed=1, cas_kt=(85.0, 87.5), qc_noise_pa=0.3)
+    with pytest.raises(ObservabilityError, match=r"near-singular information matrix: k1 and k2"):
+        identify(flight, "inverse")
+
+
+def test_vertical_speed_channel():
+    flight, truth = synthetic_flight(seed=4, vertical=True)
+    result = identify(flight)
+    assert result.success
+    assert all(abs(v) < 3 for v in _z(result, truth).values())
+
+
+def test_eiv_estimate_and_correction_direction():
+    """GPS noise is estimated; the correction moves k1 against the EIV bias."""
+    flight, _ = synthetic_flight(seed=7, model="constant", k=(0.02,), gps_noise_mps=0.3, n=16000)
+    corrected = identify(flight, "constant")
+    assert corrected.gps_noise_std_mps == pytest.approx(0.3, rel=0.1)
+    raw = identify(flight, "constant", gps_noise_std_mps=0.0)
+    # uncorrected, noise inflates the predicted q_c: k1 biased up by ~3 rho sigma^2 / q_c
+    shift = raw.value("k1") - corrected.value("k1")
+    expected = 3 * 1.196 * 0.09 / np.mean(flight.qci_pa)
+    assert shift == pytest.approx(expected, rel=0.35)
+
+
+@pytest.mark.slow
+def test_eiv_bias_below_half_sigma_at_large_n():
+    """N = 1e6, GPS noise 0.1 m/s at 5 Hz held: corrected bias < 0.5 sigma, uncorrected >> 1 sigma."""
+    rng = np.random.default_rng(0)
+    diffs_c, diffs_u = [], []
+    for seed in range(3):
+        clean, _ = synthetic_flight(seed=seed, n=1_000_000, gps_rate_hz=5.0, qc_noise_pa=0.3)
+        hold = np.repeat(np.arange(clean.n // 10), 10)
+        noise = rng.standard_normal((clean.n // 10, 2)) * 0.1
+        noisy = Flight(clean.time_s, clean.qci_pa, clean.gps_vn_mps + noise[hold, 0],
+                       clean.gps_ve_mps + noise[hold, 1], clean.rho_kgm3)
+        ref = identify(clean, gps_noise_std_mps=0.0)
+        cor = identify(noisy)
+        unc = identify(noisy, gps_noise_std_mps=0.0)
+        diffs_c.append((cor.params[:2] - ref.params[:2]) / cor.std[:2])
+        diffs_u.append((unc.params[:2] - ref.params[:2]) / cor.std[:2])
+    bias_c, bias_u = np.mean(diffs_c, axis=0), np.mean(diffs_u, axis=0)
+    assert np.all(np.abs(bias_c) < 0.5), bias_c
+    assert np.max(np.abs(bias_u)) > 2.0, bias_u
