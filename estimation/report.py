@@ -282,6 +282,9 @@ def plot(result, path=None):
     ax_dp.legend(fontsize=8, loc="best")
 
     ax_hist.hist(qci[np.isfinite(qci)], bins=40, color="tab:green", alpha=0.8)
+    # keep q >= 0 on the axis: the V_i axis above is only monotonic there
+    margin = 0.03 * (q_hi - q_lo) + 1.0
+    ax_hist.set_xlim(max(0.0, q_lo - margin), q_hi + margin)
     ax_hist.set(xlabel="q_ci (Pa)", ylabel="samples", title="Data distribution")
     ax_v = ax_hist.secondary_xaxis(
         "top", functions=(lambda q: mps_to_kt(cas_from_qc_mps(q)),
