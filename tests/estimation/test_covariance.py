@@ -1,0 +1,79 @@
+"""Covariance: plain and colored-residual forms against direct computations."""
+
+import numpy as np
+import pytest
+
+from estimation.covariance import (colored_covariance, plain_covariance, residual_acf, to_reported)
+
+
+def _ou(n, a, rng):
+    e = rng.standard_normal(n)
+    out = np.empty(n)
+    out[0] = e[0]
+    for i in range(1, n):
+        out[i] = a * out[i - 1] + np.sqrt(1 - a * a) * e[i]
+    return out
+
+
+def test_acf_matches_direct_sum():
+    r = np.random.default_rng(0).standard_normal(500)
+    acf = residual_acf(r, 5)
+    direct = [r[: r.size - k] @ r[k:] / r.size for k in range(6)]
+    assert np.allclose(acf, direct)
+
+
+@pytest.mark.parametrize("window", ["bartlett", "parzen"])
+def test_colored_equals_n2_double_sum(window):
+    rng = np.random.default_rng(1)
+    n = 400
+    jac = rng.standard_normal((n, 3)) + np.linspace(0, 1, n)[:, None]
+    r = _ou(n, 0.8, rng)
+    got = colored_covariance(jac, r, window=window, lag=20)
+    from estimation.covariance import lag_weights
+    h = lag_weights(20, window) * residual_acf(r, 20) * n / (n - 3)
+    toeplitz = np.zeros((n, n))
+    for k in range(21):
+        toeplitz += np.diag(np.full(n - k, h[k]), k) + (np.diag(np.full(n - k, h[k]), -k) if k else 0)
+    m_inv = np.linalg.inv(jac.T @ jac)
+    assert np.allclose(got.covariance, m_inv @ jac.T @ toeplitz @ jac @ m_inv)
+
+
+def test_white_residuals_reduce_to_plain():
+    rng = np.random.default_rng(2)
+    jac = rng.standard_normal((20000, 2))
+    r = rng.standard_normal(20000)
+    got = colored_covariance(jac, r)
+    assert got.lag == 0
+    assert np.allclose(got.covariance, plain_covariance(jac, r))
+
+
+def test_correlated_residuals_widen_the_bounds():
+    rng = np.random.default_rng(3)
+    n = 20000
+    jac = np.column_stack([np.ones(n), np.linspace(-1, 1, n)])
+    r = _ou(n, 0.99, rng) + 0.3 * rng.standard_normal(n)
+    got = colored_covariance(jac, r)
+    ratio = np.sqrt(np.diag(got.covariance) / np.diag(plain_covariance(jac, r)))
+    # long-run variance of AR(1) a = 0.99 over white: (1 + a) / (1 - a) ~ 199 -> std x ~13
+    assert np.all(ratio > 8) and np.all(ratio < 18)
+    assert 0.985 < got.ar1 < 0.995
+    assert np.all(np.linalg.eigvalsh(got.covariance) > 0)
+
+
+@pytest.mark.parametrize("wn, we, from_deg", [(-5.0, 0.0, 0.0), (0.0, -5.0, 90.0), (5.0, 0.0, 180.0),
+                                               (0.0, 5.0, 270.0), (-5.0, 0.00872665, 359.9)])
+def test_wind_transform(wn, we, from_deg):
+    cov = np.diag([1e-8, 0.04, 0.01])
+    params, rep = to_reported(1, np.array([0.02, wn, we]), cov)
+    assert params[1] == pytest.approx(np.hypot(wn, we))
+    assert params[2] == pytest.approx(from_deg, abs=1e-3)
+    # numerical Jacobian check of the propagated covariance
+    def f(x):
+        return to_reported(1, x, cov)[0]
+    x0 = np.array([0.02, wn, we])
+    def diff(e):
+        d = f(x0 + e) - f(x0 - e)
+        d[2] = (d[2] + 180.0) % 360.0 - 180.0       # direction wraps at north
+        return d / 2e-6
+    jac = np.column_stack([diff(e) for e in np.eye(3) * 1e-6])
+    assert np.allclose(rep, jac @ cov @ jac.T, rtol=1e-4, atol=1e-12)
