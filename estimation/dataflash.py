@@ -1,4 +1,4 @@
-"""ArduPilot DataFlash reader (binary `.bin` and text `.log`): the raw streams, for `estimation.logs`.
+"""ArduPilot DataFlash reader (binary `.bin`, text `.log`): the raw streams for `estimation.logs`.
 
 pymavlink's ``mavutil.mavlink_connection`` reads both forms. Messages read, with the field
 names of older (3.x) and newer (4.x) firmware:

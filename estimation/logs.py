@@ -8,8 +8,8 @@ same way for every format.
 
 Time
     ``time_s`` is seconds since the start of the log (the ULog header's timestamp; the first
-    data message's time-stamp in a DataFlash log), so `start_s` / `end_s` and the times in the messages are
-    the numbers a log viewer shows, less the offset of the first message.
+    data message's time-stamp in a DataFlash log), so `start_s` / `end_s` and the times in the
+    messages are the numbers a log viewer shows, less the offset of the first message.
 
 One time base
     The samples are those of the pressure stream (ArduPilot ARSP ~10 Hz, PX4
@@ -262,7 +262,8 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     path = Path(path)
     name = path.name
     if gps_resample not in _GPS_RESAMPLE:
-        raise PitotcalError(f"gps_resample {gps_resample!r} is not one of {', '.join(_GPS_RESAMPLE)}")
+        raise PitotcalError(f"gps_resample {gps_resample!r} is not one of "
+                            f"{', '.join(_GPS_RESAMPLE)}")
     for arg, value in (("gps_latency_s", gps_latency_s), ("min_groundspeed_mps",
                        min_groundspeed_mps), ("min_qci_pa", min_qci_pa)):
         if not np.isfinite(value) or value < 0:
@@ -273,6 +274,10 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     if start_s is not None and end_s is not None and end_s <= start_s:
         raise FlightDataError(f"{name}: end_s ({end_s}) must be greater than start_s ({start_s})")
     suffix = path.suffix.lower()
+    if suffix == ".tlog":
+        raise FlightDataError(f"{name}: MAVLink telemetry logs (.tlog) are not supported: their "
+                              "message times are radio arrival times; use the autopilot's "
+                              "DataFlash log (.bin) of the same flight")
     if suffix not in LOG_EXTENSIONS:
         raise FlightDataError(f"{name}: unknown log extension {path.suffix!r}; expected "
                               f"{', '.join(LOG_EXTENSIONS)} (or a flight CSV)")
@@ -387,7 +392,8 @@ def _assemble(s, name, start_s, end_s, gps_resample, gps_latency_s, min_gs, min_
         temp = np.interp(t, tt, tk)
         temp_source = f"{s.temp_source}: sensor temperature, not OAT"
         s.conversions.append(f"no outside air temperature in the log: density uses "
-                             f"{s.temp_source}, a sensor temperature, not OAT (pass oat_k, or --oat-c)")
+                             f"{s.temp_source}, a sensor temperature, not OAT "
+                             "(pass oat_k, or --oat-c)")
     else:
         temp = isa_temperature_k(alt)
         temp_source = "ISA at GPS altitude (no temperature in the log)"

@@ -65,7 +65,6 @@ def _rate_hz(t):
 def read_ulog_streams(path):
     """Read the streams of a PX4 ULog file into a `LogStreams` (times in s since log start)."""
     from pyulog import ULog
-    from pyulog.core import ULogException  # noqa: F401 (listed for readers: what pyulog raises)
 
     from .logs import LogStreams, captured_output
 

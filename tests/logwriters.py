@@ -89,7 +89,8 @@ def write_dataflash_text(path, flight, **kw):
     formats, rows = dataflash_records(flight, **kw)
     lines = ["FMT, 128, 89, FMT, BBnNZ, Type,Length,Name,Format,Columns"]
     for name, (mid, fmt, cols) in formats.items():
-        lines.append(f"FMT, {mid}, {3 + struct.calcsize('<' + _struct(fmt))}, {name}, {fmt}, {cols}")
+        length = 3 + struct.calcsize("<" + _struct(fmt))
+        lines.append(f"FMT, {mid}, {length}, {name}, {fmt}, {cols}")
     for name, vals in rows:
         lines.append(", ".join([name] + [f"{v:.9g}" if isinstance(v, float) else str(v)
                                          for v in vals]))
