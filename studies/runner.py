@@ -132,6 +132,19 @@ def _run_dask(jobs, workers, scheduler, progress):
     """Submit every job to a Dask cluster; collect rows as they finish, keep run order."""
     from distributed import Client, LocalCluster, as_completed
 
+    # The scheduler lives in this process: its INFO/WARNING chatter at shutdown ("Lost all
+    # workers", "Nanny closed") is not news to a user of a finished study.
+    quiet = logging.getLogger("distributed")
+    level = quiet.level
+    quiet.setLevel(logging.ERROR)
+    try:
+        return _submit_all(jobs, workers, scheduler, progress, Client, LocalCluster,
+                           as_completed)
+    finally:
+        quiet.setLevel(level)
+
+
+def _submit_all(jobs, workers, scheduler, progress, Client, LocalCluster, as_completed):
     cluster = None
     if scheduler is not None:
         client = Client(scheduler)
