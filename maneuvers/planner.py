@@ -99,7 +99,8 @@ class ManeuverProblem:
         sum over the runs of group g of s (psi_last - psi_first) >= 2 pi + margin,
 
     with s = +1 for right turns, -1 for left. Cost:
-    mean((p / 0.1)^2) + w_bank mean(bank^2) + w_r r2, where w_r = 0 with r2 fixed at
+    mean((p / 0.1)^2) + 0.1 mean(bank^2) + 0.03 mean(north_km^2 + east_km^2) + w_r r2, where
+    w_r = 0 with r2 fixed at
     (R - margin)^2 (planning) or w_r > 0 with r2 free (the smallest radius that fits). The q
     target is held exactly by the fixed V_k, so its closeness term is identically zero.
 
@@ -152,7 +153,10 @@ class ManeuverProblem:
                              (psi[1:] - end[2]) / _PSI, bank[1:] - end[3])
         radius = (north / _KM) ** 2 + (east / _KM) ** 2 - r2
         coverage = ca.mtimes(cover, psi)
-        cost = (ca.sumsqr(roll / _P) / n + 0.1 * ca.sumsqr(bank) / m + w_radius * r2)
+        # roll-rate smoothness, mild bank (paper: "mild turns"), and a weak pull to the centre
+        # so the track keeps room for tracking errors instead of riding the boundary
+        cost = (ca.sumsqr(roll / _P) / n + 0.1 * ca.sumsqr(bank) / m
+                + 0.03 * (ca.sumsqr(north / _KM) + ca.sumsqr(east / _KM)) / m + w_radius * r2)
         opts = {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
                 "ipopt.max_iter": 300, "ipopt.tol": 1e-7}
         for key, value in (ipopt_options or {}).items():
