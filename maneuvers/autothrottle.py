@@ -8,7 +8,8 @@ Model of the speed loop, per unit mass, around the trim true airspeed V0::
     D(V)    = g / (L/D) * (V / V0)^2   ->   dD/dV = X_u = 2 g / ((L/D) V0)   at trim
 
 so the plant from thrust command to airspeed is P(s) = 1 / ((tau_e s + 1)(s + X_u)). The
-auto-throttle is thrust_cmd = D(V_ref) + V_ref' + C(s) (V_ref - V) with a PI
+auto-throttle is thrust_cmd = [D(V_ref) + V_ref'](t + tau_e) + C(s) (V_ref - V) (feed-forward read
+one engine lag ahead from the known schedule) with a PI
 C(s) = Kp (1 + w_i / s), tuned for a phase margin at the highest crossover a PI can reach with
 w_i a fixed fraction of the crossover. The simulator (maneuvers.simulator) flies the same loop,
 with the nonlinear drag, thrust limits and anti-windup.
@@ -214,6 +215,8 @@ def check_autothrottle(plan, loop=None, *, turbulence_mps=0.0, turbulence_length
     # Feed-forward relative to the trim thrust D(V0), with the linearised drag so that the
     # loop starts in equilibrium at the schedule's first speed (zero state, inputs - inputs[0]).
     ff = x_u * (tas_ref - v0) + np.gradient(tas_ref, t)
+    # read one engine lag ahead, as the simulator's auto-throttle does (the schedule is known)
+    ff = ff[np.minimum(np.arange(t.size) + int(round(loop.engine_lag_s * rate_hz)), t.size - 1)]
     ref = tas_ref - v0
     dv = (ref[0] + control.forced_response(comp, t, ref - ref[0]).outputs
           + control.forced_response(sens * plant, t, ff - ff[0]).outputs)
