@@ -210,8 +210,8 @@ def plot_plan(plan, path=None):
         start = -0.95 * radius * np.array([d_e, d_n])
         ax_track.annotate("", xy=start + 0.45 * radius * np.array([d_e, d_n]), xytext=start,
                           arrowprops={"arrowstyle": "-|>", "color": "tab:red", "lw": 2})
-        ax_track.text(*start, f"wind {wind:g} m/s\nfrom {s.get('wind_from_deg', 0):.0f}°",
-                      color="tab:red", fontsize=8, ha="center", va="bottom")
+        ax_track.text(0.02, 0.98, f"wind {wind:g} m/s from {s.get('wind_from_deg', 0):.0f}°",
+                      transform=ax_track.transAxes, color="tab:red", fontsize=8, va="top")
     ax_track.set_aspect("equal")
     ax_track.set_xlabel("east, m")
     ax_track.set_ylabel("north, m")
