@@ -287,3 +287,22 @@ def test_default_plan_identified_back_within_3_sigma(profile):
     for i, name in enumerate(("k1", "k2", "wind_speed_mps", "wind_from_deg")):
         z = (result.params[i] - true[name]) / result.std[i]
         assert abs(z) < 3.0, f"{profile}: {name} {result.params[i]:.4g} vs {true[name]:.4g}, z={z:.2f}"
+
+
+@pytest.mark.slow
+def test_monte_carlo_default_plan_tracking_and_coverage():
+    """20 seeds: always within +-5 KCAS and near the circle; truth inside 3 sigma >= 90 %."""
+    planner = pytest.importorskip("maneuvers.planner")
+    identify = pytest.importorskip("estimation.identify").identify
+    plan = planner.plan_maneuver()
+    inside, total = 0, 0
+    for seed in range(20):
+        flight, truth = simulate(plan, seed=seed)
+        assert truth["tracking"]["max_cas_error_kt"] < 5.0
+        assert truth["tracking"]["max_radius_m"] < plan.settings["radius_m"] * 1.03
+        result = identify(flight, "inverse")
+        true = truth["parameters"]
+        for i, name in enumerate(("k1", "k2", "wind_speed_mps", "wind_from_deg")):
+            inside += abs(result.params[i] - true[name]) < 3.0 * result.std[i]
+            total += 1
+    assert inside / total >= 0.9
