@@ -10,6 +10,7 @@ import importlib.util
 import json
 import logging
 import math
+import re
 import time
 from pathlib import Path
 
@@ -79,7 +80,7 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
     -------
     dict
         The summary (also written as NAME.json): ``study``, ``n_runs``, ``n_failed``,
-        ``errors`` (message -> count), ``elapsed_s``, ``files`` and the study's own keys.
+        ``errors`` (message with numbers masked as # -> count), ``elapsed_s``, ``files`` and the study's own keys.
     """
     if runs is not None and (int(runs) != runs or runs < 1):
         raise PitotcalError(f"runs must be a positive integer, got {runs!r}")
@@ -97,7 +98,9 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
     errors = {}
     for row in rows:
         if row.get("error"):
-            errors[row["error"]] = errors.get(row["error"], 0) + 1
+            # numbers (seeds, degrees) masked so one cause is one entry; the table has the text
+            key = re.sub(r"\d+(\.\d+)?", "#", row["error"])
+            errors[key] = errors.get(key, 0) + 1
     summary = {"study": name, "description": study.description, "replicates": n_rep,
                "n_runs": len(cases), "n_rows": len(rows),
                "n_failed": sum(1 for r in rows if r.get("error")),

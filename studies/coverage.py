@@ -69,22 +69,23 @@ def _wilson(mask, z=1.96):
 def plot(rows, summary, out_dir):
     good = ok_rows(rows)
     fig, ax = new_figure(1, 3, size=(4.6, 3.8))
-    x = np.linspace(-6, 6, 241)
-    normal = np.exp(-0.5 * x * x) / np.sqrt(2 * np.pi)
-    for a, suffix, title, key in ((ax[0, 0], "_z", "corrected covariance", "coverage_2sigma"),
-                                  (ax[0, 1], "_z_plain", "plain Hessian",
-                                   "coverage_2sigma_uncorrected")):
+    # plain z-scores spread tens of σ in turbulence: a wider window, or all would be clipped
+    for a, suffix, title, key, lim in (
+            (ax[0, 0], "_z", "corrected covariance", "coverage_2sigma", 6.0),
+            (ax[0, 1], "_z_plain", "plain Hessian", "coverage_2sigma_uncorrected", 60.0)):
+        x = np.linspace(-lim, lim, 481)
+        normal = np.exp(-0.5 * x * x) / np.sqrt(2 * np.pi)
         z = np.concatenate([column(good, f"{p}{suffix}") for p in PARAMETERS])
-        z = np.clip(z[np.isfinite(z)], -6, 6)
+        z = np.clip(z[np.isfinite(z)], -lim, lim)
         if z.size:
-            a.hist(z, bins=np.linspace(-6, 6, 49), density=True, color="tab:blue", alpha=0.7,
-                   label="estimate error / reported σ")
+            a.hist(z, bins=np.linspace(-lim, lim, 49), density=True, color="tab:blue",
+                   alpha=0.7, label="estimate error / reported σ")
         a.plot(x, normal, "k-", lw=1.2, label="N(0, 1)")
         for s in (-2, 2):
             a.axvline(s, color="tab:red", ls="--", lw=0.8)
         cov = summary.get(key)
         a.set_title(f"{title}: {cov:.0%} inside ±2σ" if cov is not None else title)
-        a.set_xlabel("z-score (all parameters, clipped at ±6)")
+        a.set_xlabel(f"z-score (all parameters, clipped at ±{lim:g})")
         a.legend(fontsize=8)
     names = list(PARAMETERS)
     corr = [summary["parameters"][p]["coverage_2sigma"] or 0.0 for p in names]
