@@ -1,0 +1,15 @@
+"""Studies: Monte Carlo over simulated flights (on Dask), the paper's figures reproduced, and
+`pitotcal demo`. Public names only; each study lives in its own module (`studies.coverage`...).
+
+Example
+-------
+>>> from studies import run_study
+>>> summary = run_study("coverage", runs=4, out_dir="out", workers=0, quick=True)  # doctest: +SKIP
+"""
+
+from .catalog import get_study, rerun, run_study, study_names
+from .demo import run_demo
+from .runner import read_table, run_cases, run_one, write_table
+
+__all__ = ["run_study", "rerun", "study_names", "get_study", "run_demo",
+           "run_cases", "run_one", "read_table", "write_table"]
