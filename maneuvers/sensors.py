@@ -74,7 +74,8 @@ def impact_pressure_sensor(qc_pa, dt_s, rng, *, model="inverse", k=(0.02, -15.0)
     """
     m = get_model(model)
     if len(k) < len(m.params):
-        raise PitotcalError(f"k needs {len(m.params)} coefficients for model {model!r}, got {len(k)}")
+        raise PitotcalError(f"k needs {len(m.params)} coefficients for model {model!r}, "
+                            f"got {len(k)}")
     for name, value in (("pneumatic_lag_s", pneumatic_lag_s), ("noise_pa", noise_pa),
                         ("quantization_pa", quantization_pa)):
         if not np.isfinite(value) or value < 0:

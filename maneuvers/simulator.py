@@ -200,7 +200,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
 
     # -- controllers ---------------------------------------------------------------------------
     if speed_loop is None:
-        speed_loop = tune_autothrottle(0.5 * (float(plan.tas_mps.min()) + float(plan.tas_mps.max())))
+        speed_loop = tune_autothrottle(0.5 * float(plan.tas_mps.min() + plan.tas_mps.max()))
     kp, ki = speed_loop.kp, speed_loop.ki
     d_coef = G0_MPS2 / speed_loop.lift_to_drag / speed_loop.trim_tas_mps ** 2   # D = d_coef V^2
     thrust_max = d_coef * float(plan.tas_mps.max()) ** 2 + limits.accel_max_mps2
@@ -221,7 +221,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     # numpy calls on length-1 arrays; everything that does not feed back is done on arrays.
     nr, er, hr = ref["north_m"].tolist(), ref["east_m"].tolist(), ref["alt_m"].tolist()
     tas_r, tdot_r = ref["tas_mps"].tolist(), tas_dot_ref.tolist()
-    vgn_l, vge_l, pdff_l, clr_l = vgn_ref.tolist(), vge_ref.tolist(), psi_dot_ff.tolist(), climb_ref.tolist()
+    vgn_l, vge_l, pdff_l, clr_l = (a.tolist() for a in (vgn_ref, vge_ref, psi_dot_ff, climb_ref))
     wnp_l, wep_l, ug_l, vg_l, dug_l = (a.tolist() for a in (wn_proc, we_proc, ug, vg, dug))
     x = [nr[0], er[0], hr[0], math.radians(float(ref["heading_deg"][0])), tas_r[0]]
     bank = math.radians(float(ref["bank_deg"][0]))

@@ -19,7 +19,8 @@ def add_parser(subparsers):
     g.add_argument("--k1", type=float, help="true k1 (default 0.02)")
     g.add_argument("--k2", type=float, help="true k2 (default -15 Pa for inverse)")
     g.add_argument("--wind-speed-mps", type=float, help="mean wind speed (default: the plan's)")
-    g.add_argument("--wind-from-deg", type=float, help="mean wind FROM, deg true (default: the plan's)")
+    g.add_argument("--wind-from-deg", type=float,
+                   help="mean wind FROM, deg true (default: the plan's)")
     g.add_argument("--wind-drift-n-mps2", type=float, default=0.0, help="wind drift north, m/s^2")
     g.add_argument("--wind-drift-e-mps2", type=float, default=0.0, help="wind drift east, m/s^2")
     g.add_argument("--turbulence-mps", type=float, default=0.5, help="Dryden horizontal RMS (0.5)")
@@ -31,8 +32,10 @@ def add_parser(subparsers):
     s.add_argument("--qc-bias-pa", type=float, default=0.0, help="transducer bias (0)")
     s.add_argument("--qc-scale-error", type=float, default=0.0, help="relative gain error (0)")
     s.add_argument("--pneumatic-lag-s", type=float, default=0.0, help="tubing lag (0)")
-    s.add_argument("--gps-rate-hz", type=float, default=5.0, help="GPS update rate, 0 = every sample (5)")
-    s.add_argument("--gps-noise-mps", type=float, default=0.05, help="GPS velocity noise std (0.05)")
+    s.add_argument("--gps-rate-hz", type=float, default=5.0,
+                   help="GPS update rate, 0 = every sample (5)")
+    s.add_argument("--gps-noise-mps", type=float, default=0.05,
+                   help="GPS velocity noise std (0.05)")
     s.add_argument("--gps-latency-s", type=float, default=0.0, help="GPS velocity latency (0)")
     p.set_defaults(run=run)
     return p
