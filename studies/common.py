@@ -185,7 +185,8 @@ class Study:
 
 def ok_rows(rows):
     """The rows of runs that finished (no error) and whose solver converged."""
-    return [r for r in rows if not r.get("error") and r.get("success", True) is True]
+    # "True" as text: rows read back from a CSV (studies.runner.read_table)
+    return [r for r in rows if not r.get("error") and r.get("success", True) in (True, "True")]
 
 
 def column(rows, name):
