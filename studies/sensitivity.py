@@ -3,7 +3,9 @@
 Factors (the paper's "important influences" and its open questions): GPS velocity noise and
 rate, transducer noise, calibration bias and scale error, turbulence intensity, data rate
 5-200 Hz, wind drift during the maneuver, pneumatic lag, test-area radius and bank limit. All
-other settings stay at the T-2 baseline (the simulator's realistic defaults). Replicate r uses
+other settings stay at the T-2 baseline (the simulator's realistic defaults), flown twice: in
+calm air and in light turbulence (0.5 m/s), because turbulence swamps the sensor factors when
+present (it is the largest error source by far). Replicate r uses
 the same seed at every level of every factor (common random numbers), so a curve shows the
 factor's effect rather than sampling noise.
 """
@@ -31,29 +33,41 @@ FACTORS = {
 }
 
 
-def task(seed, factor, level):
+BACKGROUND_TURBULENCE_MPS = (0.0, 0.5)   # calm, light
+
+
+def task(seed, factor, level, background_turbulence_mps=0.5):
     where, key, _, _ = FACTORS[factor]
     value = (level, 0.0) if key == "wind_drift_mps2" else level
+    sim = {"turbulence_mps": background_turbulence_mps}
     if where == "plan":
-        return run_fly_identify(seed, plan={key: value})
-    return run_fly_identify(seed, sim={key: value})
+        return run_fly_identify(seed, plan={key: value}, sim=sim)
+    return run_fly_identify(seed, sim={**sim, key: value})
 
 
 def cases(runs, quick):
     out = []
     for r in range(runs):
         for factor, (_, _, levels, _) in FACTORS.items():
-            for level in ((levels[0], levels[-1]) if quick else levels):
-                out.append({"factor": factor, "level": float(level), "seed_offset": r})
+            backgrounds = (0.5,) if factor == "turbulence_mps" else BACKGROUND_TURBULENCE_MPS
+            for background in backgrounds:
+                for level in ((levels[0], levels[-1]) if quick else levels):
+                    out.append({"factor": factor, "level": float(level),
+                                "background_turbulence_mps": background, "seed_offset": r})
     return out
 
 
 def summarize(rows):
     out = {}
-    for (factor, level), rs in group(rows, "factor", "level").items():
+    for (factor, background, level), rs in group(rows, "factor", "background_turbulence_mps",
+                                                 "level").items():
         good = ok_rows(rs)
-        out.setdefault(factor, {"label": FACTORS[factor][3], "levels": []})["levels"].append({
-            "level": level, "n_runs": len(rs), "n_ok": len(good),
+        entry = out.setdefault(factor, {"label": FACTORS[factor][3], "levels": []})
+        if factor == "turbulence_mps":
+            background = None          # the factor itself
+        entry["levels"].append({
+            "level": level, "background_turbulence_mps": background,
+            "n_runs": len(rs), "n_ok": len(good),
             "dv_2sigma_max_kt": stats(good, "dv_2sigma_max_kt")["median"],
             "dv_err_max_kt_rms": stats(good, "dv_err_max_kt")["rms"],
             "dv_inside_2sigma": stats(good, "dv_inside_2sigma")["mean"],
@@ -70,14 +84,18 @@ def plot(rows, summary, out_dir):
     nrows = max(1, int(np.ceil(len(factors) / ncols)))
     fig, ax = new_figure(nrows, ncols, size=(3.6, 2.9))
     for a, (factor, entry) in zip(ax.flat, factors.items()):
-        lv = entry["levels"]
-        x = np.array([e["level"] for e in lv], dtype=float)
-        two = np.array([np.nan if e["dv_2sigma_max_kt"] is None else e["dv_2sigma_max_kt"]
-                        for e in lv])
-        err = np.array([np.nan if e["dv_err_max_kt_rms"] is None else e["dv_err_max_kt_rms"]
-                        for e in lv])
-        a.plot(x, two, "o-", label="2σ of ΔV")
-        a.plot(x, err, "s--", label="ΔV error (rms)")
+        for background, color in ((None, "tab:blue"), (0.5, "tab:blue"), (0.0, "tab:orange")):
+            lv = [e for e in entry["levels"] if e.get("background_turbulence_mps") == background]
+            if not lv:
+                continue
+            tag = "" if background is None else (" calm" if background == 0 else " turb 0.5")
+            x = np.array([e["level"] for e in lv], dtype=float)
+            two = np.array([np.nan if e["dv_2sigma_max_kt"] is None else e["dv_2sigma_max_kt"]
+                            for e in lv])
+            err = np.array([np.nan if e["dv_err_max_kt_rms"] is None
+                            else e["dv_err_max_kt_rms"] for e in lv])
+            a.plot(x, two, "o-", color=color, label="2σ of ΔV" + tag)
+            a.plot(x, err, "s--", color=color, label="ΔV error (rms)" + tag)
         a.set_xlabel(entry["label"])
         a.set_yscale("log")
         if factor in ("rate_hz", "gps_rate_hz"):

@@ -20,7 +20,7 @@ SUMMARY_COMMON = {"study", "n_runs", "n_rows", "n_failed", "errors", "seed", "el
 LEAN = {  # name -> (runs, study columns, study summary keys)
     "sample-size": (1, {"n_samples_used", "window_s"}, {"by_n_samples", "settled_n_samples"}),
     "maneuvers": (1, {"profile", "duration_s"}, {"by_profile", "best_at_240s"}),
-    "sensitivity": (1, {"factor", "level"}, {"factors"}),
+    "sensitivity": (1, {"factor", "level", "background_turbulence_mps"}, {"factors"}),
     "coverage": (4, {"turbulence_mps"}, {"coverage_2sigma", "coverage_2sigma_uncorrected",
                                          "parameters", "n_runs_used"}),
     "wind": (1, {"profile", "wind_speed_mps", "wind_from_deg"}, {"by_profile"}),
