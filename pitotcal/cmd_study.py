@@ -40,8 +40,11 @@ def run(args):
     summary = run_study(args.name, runs=args.runs, out_dir=args.out, seed=args.seed,
                         workers=args.workers, scheduler=args.scheduler, quick=args.quick,
                         progress=_Bar(args.name) if sys.stderr.isatty() else _Counter(args.name))
-    print(f"study {args.name}: {summary.get('n_runs', '?')} runs, "
-          f"{summary.get('n_failed', 0)} failed, {summary.get('elapsed_s', '?')} s")
+    if "n_runs" in summary:
+        print(f"study {args.name}: {summary['n_runs']} runs, {summary['n_failed']} failed, "
+              f"{summary['elapsed_s']} s")
+    else:
+        print(f"study {args.name}: done")
     for key in ("coverage_2sigma", "coverage_2sigma_uncorrected"):
         if summary.get(key) is not None:
             print(f"  {key}: {summary[key]:.3f}")

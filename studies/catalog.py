@@ -131,7 +131,9 @@ def _run_external(name, out, runs, seed):
     fun = getattr(importlib.import_module(module), function)
     out.mkdir(parents=True, exist_ok=True)
     kwargs = {"seed": seed, **({"runs": runs} if runs is not None else {})} if takes_runs else {}
-    return fun(out, **kwargs)
+    summary = dict(fun(out, **kwargs))
+    summary.setdefault("files", sorted(str(p) for p in out.glob(f"{name}*")))
+    return summary
 
 
 def _json_ready(value):
