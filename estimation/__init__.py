@@ -5,7 +5,7 @@ The public names; everything else is an implementation detail of its module.
 
 from .errors import FlightDataError, ObservabilityError, PitotcalError
 from .flight import Flight, read_flight, write_flight_csv
-from .identify import identify
+from .identification import identify
 from .models import MODELS, get_model
 from .oe import OutputErrorProblem
 from .result import IdentificationResult

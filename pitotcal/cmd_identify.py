@@ -40,7 +40,7 @@ def run(args):
 
     from estimation.errors import PitotcalError
     from estimation.flight import read_flight
-    from estimation.identify import identify
+    from estimation import identify
     from estimation.models import MODELS
 
     if args.model not in MODELS and args.model != "auto":

@@ -58,7 +58,7 @@ def _wind_score(est, cov, true):
 def compare_one_flight(flight, truth, *, times_s=DEFAULT_TIMES_S, model="constant",
                        vi_ref_kt=85.0):
     """Rows {method, T_s, dv_err_kt, dv_2sigma_kt, dv_covered, wind_err_mps, ...} of one flight."""
-    from estimation.identify import identify
+    from estimation import identify
 
     if not times_s or any(t <= 0 for t in times_s):
         raise PitotcalError(f"times_s must be positive seconds, got {times_s!r}")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from estimation.errors import FlightDataError, PitotcalError
-from estimation.identify import identify
+from estimation import identify
 from estimation.logs import _onto, load_log, read_log
 from estimation.units import RHO0_KGM3
 from logwriters import write_dataflash_bin, write_dataflash_text, write_ulog

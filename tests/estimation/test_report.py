@@ -129,7 +129,7 @@ def test_plot_writes_a_readable_png(tmp_path):
 
 
 def test_real_identification_round_trips_through_json(tmp_path):
-    from estimation.identify import identify
+    from estimation import identify
 
     flight, truth = synthetic_flight(seed=4, n=4000, turbulence_mps=0.3, gps_rate_hz=5.0,
                                      gps_noise_mps=0.05)

@@ -278,7 +278,7 @@ def test_cli_bad_input_exit_2_one_line(tmp_path, plan, capsys, content, args, ma
 @pytest.mark.parametrize("profile", ["continuous", "step-pause", "two-speed"])
 def test_default_plan_identified_back_within_3_sigma(profile):
     planner = pytest.importorskip("maneuvers.planner")
-    identify = pytest.importorskip("estimation.identify").identify
+    identify = pytest.importorskip("estimation").identify
     plan = planner.plan_maneuver(profile=profile)
     flight, truth = simulate(plan, seed=0)
     assert truth["tracking"]["max_cas_error_kt"] < 5.0
@@ -293,7 +293,7 @@ def test_default_plan_identified_back_within_3_sigma(profile):
 def test_monte_carlo_default_plan_tracking_and_coverage():
     """20 seeds: always within +-5 KCAS and near the circle; truth inside 3 sigma >= 90 %."""
     planner = pytest.importorskip("maneuvers.planner")
-    identify = pytest.importorskip("estimation.identify").identify
+    identify = pytest.importorskip("estimation").identify
     plan = planner.plan_maneuver()
     inside, total = 0, 0
     for seed in range(20):
