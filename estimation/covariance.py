@@ -16,8 +16,8 @@ __all__ = ["plain_covariance", "colored_covariance", "ColoredCovariance", "resid
 MIN_LAG = 10
 
 
-def plain_covariance(jac, residuals):
-    """Plain (Cramer-Rao) covariance s^2 (J^T J)^-1.
+def plain_covariance(jac, residuals, information=None):
+    """Plain (Cramer-Rao) covariance s^2 M^-1, M = J^T J or the given information matrix.
 
     Parameters
     ----------
@@ -25,6 +25,8 @@ def plain_covariance(jac, residuals):
         Output sensitivities dr/dtheta at the optimum.
     residuals : ndarray, shape (N,)
         Output residuals, Pa.
+    information : ndarray, shape (p, p), optional
+        M from the exact Hessian of the objective (`estimation.oe`); J^T J when None.
 
     Returns
     -------
@@ -33,7 +35,7 @@ def plain_covariance(jac, residuals):
     """
     n, p = jac.shape
     s2 = float(residuals @ residuals) / max(n - p, 1)
-    return s2 * _inv_sym(jac.T @ jac)
+    return s2 * _inv_sym(jac.T @ jac if information is None else information)
 
 
 @dataclass(frozen=True)
@@ -92,7 +94,7 @@ def lag_weights(lag, window="bartlett"):
     return np.where(x <= 0.5, 1 - 6 * x ** 2 + 6 * x ** 3, 2 * (1 - x) ** 3)
 
 
-def colored_covariance(jac, residuals, *, window="exponential", lag=None):
+def colored_covariance(jac, residuals, *, window="exponential", lag=None, information=None):
     """Covariance corrected for colored residuals (Morelli & Klein 1997; SIDPAC `colores`).
 
     Parameters
@@ -106,6 +108,8 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None):
         "parzen" taper the sample autocovariance with that lag window.
     lag : int, optional
         Truncation lag of "bartlett"/"parzen", samples; Andrews' AR(1) plug-in when None.
+    information : ndarray, shape (p, p), optional
+        M from the exact Hessian of the objective; S^T S when None.
 
     Returns
     -------
@@ -119,7 +123,7 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None):
 
     and R cancels: Cov = (S^T S)^-1 S^T (H S) (S^T S)^-1 with H the Toeplitz matrix of
     h(k) = w(k) R_vv(k). H S is a convolution of each sensitivity column with h, done by FFT
-    (overlap-add): O(N log N), never the N x N double sum. Summing every lag of a sample
+    O(N log N), never the N x N double sum. Summing every lag of a sample
     autocovariance is degenerate (it collapses toward zero for zero-mean residuals), so R_vv
     needs a model or a lag window. The default models it as white noise plus an exponential
     decay, fitted to the residuals' autocovariance as the fit leaves it (`_exponential_acov`).
@@ -143,7 +147,7 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None):
         acov = residual_acf(residuals, lag) * n / max(n - p, 1)
         h = lag_weights(lag, window) * acov
     hs = _toeplitz_times(h, jac)
-    m_inv = _inv_sym(jac.T @ jac)
+    m_inv = _inv_sym(jac.T @ jac if information is None else information)
     middle = jac.T @ hs
     cov = m_inv @ (0.5 * (middle + middle.T)) @ m_inv
     warning = None

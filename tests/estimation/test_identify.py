@@ -86,7 +86,7 @@ def test_auto_picks_true_structure_on_clear_data():
 
 def test_nonconvergence_is_a_result_not_an_exception():
     flight, _ = synthetic_flight(seed=2, wind_from_deg=90.0)
-    result = identify(flight, ipopt_options={"max_iter": 1})
+    result = identify(flight, ipopt_options={"max_iter": 0})
     assert not result.success
     assert result.message == "Maximum_Iterations_Exceeded"
     assert any("did not converge" in w for w in result.warnings)
