@@ -107,17 +107,13 @@ class OutputErrorProblem:
         nk = len(m.params)
         x = ca.MX.sym("x", nk + 2)
         qci, vn, ve, rho = (ca.MX.sym(name, n) for name in ("qci", "vn", "ve", "rho"))
-        channels = [qci, vn, ve, rho]
-        if has_vd:
-            vd2 = ca.MX.sym("vd2", n)
-            channels.append(vd2)
+        vd2 = ca.MX.sym("vd2", n) if has_vd else None
+        channels = [qci, vn, ve, rho] + ([vd2] if has_vd else [])
         # scalars: c_eiv = n sigma^2, pen_a = 4 sigma^2, pen_b = 2 n sigma^4, weight w
         sc = ca.MX.sym("scalars", 4)
         k = [x[i] * m.scales[i] for i in range(nk)]
         wn, we = x[nk], x[nk + 1]
-        v2 = (vn - wn) ** 2 + (ve - we) ** 2
-        if has_vd:
-            v2 = v2 + vd2
+        v2 = _tas_sq(vn, ve, wn, we, vd2)        # same arithmetic on MX as on numpy
         a = 0.5 * rho * (1.0 - m.ratio(k, qci))
         r = qci - a * (v2 - sc[0])
         spread = ca.dot(a * a, sc[1] * v2 - sc[2])
@@ -247,10 +243,25 @@ def _residual_np(model, theta, qci, vn, ve, rho, vd2, c_eiv):
     """The output residual of `OutputErrorProblem` in numpy (for start values and checks)."""
     nk = len(model.params)
     k, wn, we = theta[:nk], theta[nk], theta[nk + 1]
+    return qci - (1.0 - model(k, qci)) * 0.5 * rho * (_tas_sq(vn, ve, wn, we, vd2) - c_eiv)
+
+
+def _tas_sq(vn, ve, wn, we, vd2):
+    """V_t^2 = (V_gn - wind_n)^2 + (V_ge - wind_e)^2 [+ V_gd^2] (INTERFACES §2)."""
     v2 = (vn - wn) ** 2 + (ve - we) ** 2
-    if vd2 is not None:
-        v2 = v2 + vd2
-    return qci - (1.0 - model(k, qci)) * 0.5 * rho * (v2 - c_eiv)
+    return v2 if vd2 is None else v2 + vd2
+
+
+def _ratio_columns(model, k, qci):
+    """d f(q_ci; k) / d k_i for each coefficient, by central differences (exact when f is
+    linear in k, as every registered structure is)."""
+    cols = []
+    for i, h in enumerate(model.scales):
+        up, dn = k.copy(), k.copy()
+        up[i] += h
+        dn[i] -= h
+        cols.append((model(up, qci) - model(dn, qci)) / (2 * h))
+    return cols
 
 
 def _sensitivities_np(model, theta, qci, vn, ve, rho, vd2, c_eiv):
@@ -262,18 +273,9 @@ def _sensitivities_np(model, theta, qci, vn, ve, rho, vd2, c_eiv):
     """
     nk = len(model.params)
     k, wn, we = theta[:nk], theta[nk], theta[nk + 1]
-    v2 = (vn - wn) ** 2 + (ve - we) ** 2
-    if vd2 is not None:
-        v2 = v2 + vd2
-    qc_pred = 0.5 * rho * (v2 - c_eiv)
+    qc_pred = 0.5 * rho * (_tas_sq(vn, ve, wn, we, vd2) - c_eiv)
     a = (1.0 - model(k, qci)) * 0.5 * rho
-    cols = []
-    for i in range(nk):
-        h = model.scales[i]
-        up, dn = k.copy(), k.copy()
-        up[i] += h
-        dn[i] -= h
-        cols.append(qc_pred * (model(up, qci) - model(dn, qci)) / (2 * h))
+    cols = [qc_pred * col for col in _ratio_columns(model, k, qci)]
     cols += [2.0 * a * (vn - wn), 2.0 * a * (ve - we)]
     return np.column_stack(cols)
 
@@ -317,23 +319,13 @@ def start_values(model, qci_pa, vn_mps, ve_mps, rho_kgm3, vd2=None, c_eiv=0.0):
     k = np.zeros(nk)
     k[0] = 1.0 - c
     # Gauss-Newton on the ratio (exact in one step for models linear in k)
-    v2 = (vn_mps - wn) ** 2 + (ve_mps - we) ** 2 - c_eiv
-    if vd2 is not None:
-        v2 = v2 + vd2
-    qc = 0.5 * rho_kgm3 * v2
+    qc = 0.5 * rho_kgm3 * (_tas_sq(vn_mps, ve_mps, wn, we, vd2) - c_eiv)
     ok = qc > 0
     ratio = 1.0 - qci_pa[ok] / qc[ok]
     q = qci_pa[ok]
     for _ in range(2):
-        f0 = model(k, q)
-        cols = []
-        for i in range(nk):
-            h = model.scales[i]
-            up, dn = k.copy(), k.copy()
-            up[i] += h
-            dn[i] -= h
-            cols.append((model(up, q) - model(dn, q)) / (2 * h))
-        step = np.linalg.lstsq(np.column_stack(cols), ratio - f0, rcond=None)[0]
+        step = np.linalg.lstsq(np.column_stack(_ratio_columns(model, k, q)), ratio - model(k, q),
+                               rcond=None)[0]
         k = k + step
     return np.concatenate([k, [wn, we]])
 
