@@ -214,6 +214,21 @@ def stats(rows, name):
             "p95_abs": float(np.percentile(np.abs(x), 95.0)), "n": int(x.size)}
 
 
+def accuracy_summary(rows, **extra_errors):
+    """Per-case accuracy of ΔV and the wind over a group of run rows (failed runs counted)."""
+    good = ok_rows(rows)
+    summary = {
+        "n_runs": len(rows), "n_ok": len(good),
+        "dv_2sigma_max_kt": stats(good, "dv_2sigma_max_kt")["median"],
+        "dv_err_max_kt_rms": stats(good, "dv_err_max_kt")["rms"],
+        "dv_inside_2sigma": stats(good, "dv_inside_2sigma")["mean"],
+        "wind_speed_err_rms_mps": stats(good, "wind_speed_mps_err")["rms"],
+    }
+    summary.update({key: stats(good, name)["rms"] for key, name in extra_errors.items()})
+    summary["errors"] = sorted({r["error"] for r in rows if r.get("error")})
+    return summary
+
+
 def new_figure(nrows=1, ncols=1, size=(6.0, 4.0)):
     """A matplotlib Figure without pyplot (no GUI backend, safe in workers and CI)."""
     from matplotlib.figure import Figure

@@ -8,7 +8,7 @@ planned in that time is a row with the planner's message.
 
 import numpy as np
 
-from .common import Study, group, new_figure, ok_rows, run_fly_identify, save, stats
+from .common import Study, accuracy_summary, group, new_figure, run_fly_identify, save
 
 __all__ = ["STUDY", "PROFILES", "DURATIONS_S"]
 
@@ -30,15 +30,8 @@ def cases(runs, quick):
 def summarize(rows):
     out = {}
     for (profile, duration), rs in group(rows, "profile", "duration_s").items():
-        good = ok_rows(rs)
-        out.setdefault(profile, {})[str(int(duration))] = {
-            "n_runs": len(rs), "n_ok": len(good),
-            "dv_2sigma_max_kt": stats(good, "dv_2sigma_max_kt")["median"],
-            "dv_err_max_kt_rms": stats(good, "dv_err_max_kt")["rms"],
-            "dv_inside_2sigma": stats(good, "dv_inside_2sigma")["mean"],
-            "wind_speed_err_rms_mps": stats(good, "wind_speed_mps_err")["rms"],
-            "wind_from_err_rms_deg": stats(good, "wind_from_deg_err")["rms"],
-            "errors": sorted({r["error"] for r in rs if r.get("error")})}
+        out.setdefault(profile, {})[str(int(duration))] = accuracy_summary(
+            rs, wind_from_err_rms_deg="wind_from_deg_err")
     return {"by_profile": out, "best_at_240s": _best(out, "240")}
 
 

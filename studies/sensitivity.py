@@ -12,7 +12,7 @@ factor's effect rather than sampling noise.
 
 import numpy as np
 
-from .common import Study, group, new_figure, ok_rows, run_fly_identify, save, stats
+from .common import Study, accuracy_summary, group, new_figure, run_fly_identify, save
 
 __all__ = ["STUDY", "FACTORS"]
 
@@ -61,20 +61,12 @@ def summarize(rows):
     out = {}
     for (factor, background, level), rs in group(rows, "factor", "background_turbulence_mps",
                                                  "level").items():
-        good = ok_rows(rs)
         entry = out.setdefault(factor, {"label": FACTORS[factor][3], "levels": []})
         if factor == "turbulence_mps":
             background = None          # the factor itself
         entry["levels"].append({
             "level": level, "background_turbulence_mps": background,
-            "n_runs": len(rs), "n_ok": len(good),
-            "dv_2sigma_max_kt": stats(good, "dv_2sigma_max_kt")["median"],
-            "dv_err_max_kt_rms": stats(good, "dv_err_max_kt")["rms"],
-            "dv_inside_2sigma": stats(good, "dv_inside_2sigma")["mean"],
-            "k1_err_rms": stats(good, "k1_err")["rms"],
-            "k2_err_rms_pa": stats(good, "k2_err")["rms"],
-            "wind_speed_err_rms_mps": stats(good, "wind_speed_mps_err")["rms"],
-            "errors": sorted({r["error"] for r in rs if r.get("error")})})
+            **accuracy_summary(rs, k1_err_rms="k1_err", k2_err_rms_pa="k2_err")})
     return {"factors": out}
 
 
