@@ -26,9 +26,10 @@ def run(args):
           f"{args.duration_s:g} s, 5 m/s wind from 270°, seed {args.seed}")
     print(f"identified {res.model} model from {res.n_samples} samples "
           f"({'converged' if res.success else 'NOT converged: ' + res.message})")
+    print(f"  {'parameter':15s} {'value':>10s}   {'±2σ':>6s}   {'truth':>10s}")
     for name in res.param_names:
         value, two = res.value(name), 2 * res.stddev(name)
-        print(f"  {name:15s} {value:+10.4f} ± {two:.4f}   truth {truth.get(name, float('nan')):+10.4f}")
+        print(f"  {name:15s} {value:+10.4f} ± {two:<8.4g} {truth.get(name, float('nan')):+10.4f}")
     wind_kt = mps_to_kt(res.value("wind_speed_mps"))
     print(f"  wind: {wind_kt:.1f} kt from {res.value('wind_from_deg'):.0f}° "
           f"(truth {mps_to_kt(truth['wind_speed_mps']):.1f} kt from {truth['wind_from_deg']:.0f}°)")
