@@ -43,13 +43,13 @@ class ColoredCovariance:
     """The colored-residual covariance and how it was computed."""
 
     covariance: np.ndarray
-    lag: int                 # truncation lag of the window, samples
+    lag: int                 # last lag of R_vv used, samples
     window: str
-    ar1: float               # lag-1 autocorrelation of the residuals used by the plug-in
+    ar1: float               # exponential: decay per sample; windows: lag-1 autocorrelation
     warning: str | None = None
 
     def describe(self):
-        return f"{self.window} window, truncation lag {self.lag} samples (residual AR(1) {self.ar1:.4f})"
+        return f"{self.window} R_vv, {self.lag} lags (decay/AR(1) {self.ar1:.4f} per sample)"
 
 
 def residual_acf(residuals, max_lag):
