@@ -33,7 +33,9 @@ What is rejected and what is dropped
     samples should not stop anybody): rows where a used column is non-numeric, empty, missing
     (short row), NaN or infinite, where `qc_pa` <= 0, or where `rho_kgm3`, `ps_pa` or `oat_k`
     is <= 0, as long as they are at most 1 % of the rows (counted inside the time window).
-    The count is kept in `Flight.n_dropped`.
+    The count is kept in `Flight.n_dropped`. The informative column `alt_m` (never used in
+    the fit) is exempt: an empty, non-numeric or NaN altitude is NaN in `Flight.alt_m` and
+    the row is kept.
 
     Valid as they are: gaps in time, extra columns (ignored), blank lines, `#` comment lines
     before the header (``# key: value`` goes to `Flight.meta`), Windows line ends, a UTF-8 BOM.
@@ -74,7 +76,7 @@ class Flight:
     gps_vd_mps : ndarray or None
         GPS velocity down, m/s; when present it enters the true-airspeed magnitude.
     alt_m : ndarray or None
-        Altitude, m (for plots and checks only).
+        Altitude, m (for plots and checks only; NaN where the file had no usable value).
     source : str
         Where the data came from (file name), used in error messages.
     meta : dict
@@ -139,6 +141,9 @@ OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m")
 LOG_EXTENSIONS = (".ulg", ".bin", ".log", ".tlog")
 MAX_BAD_FRACTION = 0.01      # more unusable rows than this is a bad column, not a glitch
 MIN_ROWS = 10
+# Read when present but never used in the fit (plots, checks): a bad cell there is NaN in
+# `Flight.alt_m`, not a reason to drop the row or reject the file.
+_INFORMATIVE = ("alt_m",)
 
 # Unit diagnosis (see the module docstring). q_ci / (0.5 rho |V_g|^2) of a flying aircraft is
 # 1 / (1 + (W/V)^2) on a full circle and at worst (1 -/+ W/V)^-2 on one leg: 0.35-4 covers
@@ -462,9 +467,11 @@ def _window(name, table, jt, start_s, end_s):
 
 def _row_problem(table, data_row, r, use):
     """(column, problem) of a row, or None if it is usable."""
-    if r in table.bad:
+    if r in table.bad and table.bad[r][0] not in _INFORMATIVE:
         return table.bad[r]
     for c, v in zip(use, data_row):
+        if c in _INFORMATIVE:
+            continue
         if np.isnan(v):
             return c, "NaN"
         if np.isinf(v):
@@ -478,13 +485,20 @@ def _row_problem(table, data_row, r, use):
 
 def _drop_bad_rows(name, table, data, rows, use):
     col = {c: j for j, c in enumerate(use)}
-    bad = ~np.isfinite(data).all(axis=1)
+    used = [j for j, c in enumerate(use) if c not in _INFORMATIVE]
+    bad = ~np.isfinite(data[:, used]).all(axis=1)
     bad |= data[:, col["qc_pa"]] <= 0
     for c in ("rho_kgm3", "ps_pa", "oat_k"):
         if c in col:
             bad |= data[:, col[c]] <= 0
     if table.bad:
-        bad |= np.isin(rows, np.fromiter(table.bad, dtype=int))
+        # a row whose first problem is in an informative column has no problem elsewhere
+        # (cells are checked in `use` order, informative columns last)
+        bad |= np.isin(rows, [r for r, (c, _) in table.bad.items() if c not in _INFORMATIVE])
+    for c in _INFORMATIVE:
+        if c in col:            # informative only: a bad cell is NaN there, the row stays
+            v = data[:, col[c]]
+            data[:, col[c]] = np.where(np.isfinite(v), v, np.nan)
     n_bad, n = int(bad.sum()), data.shape[0]
     if n_bad == 0:
         return data, rows, 0
@@ -507,6 +521,8 @@ def _drop_bad_rows(name, table, data, rows, use):
 
 def _whole_column_bad(table, data, rows, use):
     for j, c in enumerate(use):
+        if c in _INFORMATIVE:
+            continue
         v = data[:, j]
         ok = np.isfinite(v) & ((v > 0) if c in ("qc_pa", "rho_kgm3", "ps_pa", "oat_k") else True)
         ok &= ~np.isin(rows, [r for r, (cc, _) in table.bad.items() if cc == c])

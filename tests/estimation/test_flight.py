@@ -273,3 +273,22 @@ def test_reads_a_million_rows_quickly(tmp_path):
     elapsed = time.perf_counter() - t0
     assert g.n == 200_000
     assert elapsed < 3.0, f"{elapsed:.2f} s for 2e5 rows (measured ~0.2 s on an idle machine)"
+
+
+def test_bad_altitude_cells_keep_the_row(tmp_path):
+    """alt_m is informative only: empty/NaN/text altitude is NaN, never a dropped row."""
+    cols = columns()
+    cols["alt_m"] = np.full(N, 244.0)
+    cells = {(r, "alt_m"): ("" if r % 3 == 0 else "nan" if r % 3 == 1 else "n/a")
+             for r in range(0, N, 7)}
+    cells[(10, "qc_pa")] = "nan"                          # a real bad row is still dropped
+    path = write(tmp_path / "f.csv", cols, cells)
+    with pytest.warns(UserWarning, match=r"dropped 1 of 500 rows .*column qc_pa, row 11"):
+        g = read_flight(path)
+    assert g.n == N - 1 and g.n_dropped == 1
+    assert np.isnan(g.alt_m).sum() == len(range(0, N, 7))
+    empty = write(tmp_path / "e.csv", cols, {(r, "alt_m"): "" for r in range(N)})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        g = read_flight(empty)
+    assert g.n == N and np.isnan(g.alt_m).all()
