@@ -53,6 +53,11 @@ def run(args):
         # an output on top of the input would destroy the flight data: refuse before anything
         if out is not None and Path(out).resolve() == source.resolve():
             raise PitotcalError(f"{option} {out}: would overwrite the input flight file")
+        # and an output that cannot be written is said before the work, not after it
+        if out is not None and not Path(out).resolve().parent.is_dir():
+            raise PitotcalError(f"{option} {out}: directory {Path(out).parent} does not exist")
+    if args.plot is not None:
+        _check_plot_format(args.plot)
 
     flight = read_flight(source, start_s=args.start_s, end_s=args.end_s)
     result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
@@ -70,6 +75,20 @@ def run(args):
             f.write("\n")
         print(f"\nWrote {args.json}")
     if args.plot is not None:
-        result.plot(args.plot)
-        print(f"{'' if args.json else chr(10)}Wrote {args.plot}")
+        # matplotlib writes PNG and appends ".png" to a name without extension: say so
+        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+        result.plot(plot_path)
+        print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
     return 0
+
+
+def _check_plot_format(path):
+    """Refuse a figure extension matplotlib cannot write (no extension: PNG)."""
+    from estimation.errors import PitotcalError
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    ext = Path(path).suffix.lower().lstrip(".")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if ext and ext not in formats:
+        raise PitotcalError(f"--plot {path}: unknown figure format {ext!r}; use one of "
+                            f"{', '.join(sorted(formats))}")

@@ -161,3 +161,28 @@ def test_real_subprocess_bad_input_and_good_run(flight_csv, tmp_path):
                           capture_output=True, text=True, env=env, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert "Airspeed correction" in proc.stdout
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--plot", "r.xyz"], r"--plot .*r\.xyz: unknown figure format 'xyz'; use one of .*png"),
+    (["--json", "nodir/r.json"], r"--json .*nodir/r\.json: directory .*nodir does not exist"),
+    (["--plot", "nodir/r.png"], r"--plot .*nodir/r\.png: directory .*nodir does not exist"),
+])
+def test_unwritable_outputs_are_refused_before_the_work(flight_csv, tmp_path, capsys, args,
+                                                        match):
+    import re
+
+    path, _ = flight_csv
+    args = [a if a.startswith("--") else str(tmp_path / a) for a in args]
+    status = main(["identify", str(path), *args])
+    captured = capsys.readouterr()
+    assert status == 2 and captured.err.count("\n") == 1 and re.search(match, captured.err), \
+        captured.err
+    assert captured.out == "" and "Traceback" not in captured.err
+
+
+def test_plot_without_extension_is_png_and_named(flight_csv, tmp_path, capsys):
+    path, _ = flight_csv
+    assert main(["identify", str(path), "--plot", str(tmp_path / "fig")]) == 0
+    assert f"Wrote {tmp_path / 'fig.png'}" in capsys.readouterr().out
+    assert (tmp_path / "fig.png").read_bytes()[:4] == b"\x89PNG"
