@@ -79,7 +79,43 @@ def _good_lines(n=200, qc_scale=1.0, nan_rows=()):
     return lines
 
 
+def _edited(cells=None, scale=None, celsius=False):
+    """_good_lines with {(row, column): text} cells, {column: factor} scales, or ps/oat in degC."""
+    lines = _good_lines()
+    names = lines[0].split(",")
+    rows = [line.split(",") for line in lines[1:]]
+    for c, k in (scale or {}).items():
+        for row in rows:
+            row[names.index(c)] = f"{float(row[names.index(c)]) * k:.6g}"
+    for (r, c), text in (cells or {}).items():
+        rows[r][names.index(c)] = text
+    if celsius:                      # rho -> ps_pa at 15 degC, oat written in degC
+        names[-1:] = ["ps_pa", "oat_k"]
+        rows = [row[:-1] + [f"{float(row[-1]) * 287.05287 * 288.15:.6g}", "15.0"]
+                for row in rows]
+    return "\n".join([",".join(names)] + [",".join(row) for row in rows]) + "\n"
+
+
+def _cells(column, text, rows=range(10, 20)):
+    return {(r, column): text for r in rows}
+
+
 BAD = [
+    ("not a CSV", "hello world\nthis is text\n", r"bad.csv: line 1: not a CSV header"),
+    ("non-numeric", _edited(_cells("gps_vn_mps", "abc")),
+     r"bad.csv: column gps_vn_mps, row 11 \(line 12\): non-numeric value 'abc'"),
+    ("inf", _edited(_cells("rho_kgm3", "inf")), r"bad.csv: column rho_kgm3, row 11 \(line 12\): "
+     "infinite"),
+    ("q_ci <= 0", _edited(_cells("qc_pa", "0")),
+     r"bad.csv: column qc_pa, row 11 \(line 12\): q_ci = 0 Pa is not positive"),
+    ("time backwards", _edited({(30, "time_s"): "-1"}),
+     r"bad.csv: column time_s, row 31 \(line 32\): time -1 s is before the previous row's"),
+    ("q_ci in kPa", _edited(scale={"qc_pa": 0.001}), r"bad.csv: column qc_pa: median .* looks "
+     "like kPa"),
+    ("speeds in knots", _edited(scale={"gps_vn_mps": 1.9438, "gps_ve_mps": 1.9438}),
+     r"bad.csv: columns gps_vn_mps/gps_ve_mps: median ground speed .* looks like knots"),
+    ("oat in Celsius", _edited(celsius=True),
+     r"bad.csv: column oat_k: median 15 looks like degrees Celsius"),
     ("empty", "", "bad.csv: empty file"),
     ("binary", b"ULog\x01\x12\x35\x00\x00", r"bad.csv: PX4 ULog file \(name it \.ulg"),
     ("header only", "time_s,qc_pa,gps_vn_mps,gps_ve_mps,rho_kgm3\n", "bad.csv: header only"),
