@@ -147,7 +147,14 @@ def _run_dask(jobs, workers, scheduler, progress):
 def _submit_all(jobs, workers, scheduler, progress, Client, LocalCluster, as_completed):
     cluster = None
     if scheduler is not None:
-        client = Client(scheduler)
+        try:
+            client = Client(scheduler)
+        except (OSError, ValueError, TypeError) as exc:
+            # a typo'd address is bad input: one line, exit 2 (not a distributed traceback)
+            text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise PitotcalError(f"--scheduler {scheduler!r}: cannot connect to a Dask "
+                                f"scheduler ({text}); expected e.g. tcp://HOST:8786 with "
+                                f"`dask scheduler` running there") from None
     else:
         n = workers or os.cpu_count() or 1
         # processes, one thread each: CasADi/IPOPT and numpy work best unshared; no dashboard.

@@ -59,3 +59,9 @@ def test_table_round_trip(tmp_path):
     back = read_table(write_table(rows, tmp_path / "t.csv"))
     assert back[0]["a"] == 1.0 and back[0]["b"] == "x" and math.isnan(back[0]["c"])
     assert math.isnan(back[1]["a"]) and back[1]["c"] == 2.5
+
+
+@pytest.mark.parametrize("address", ["nonsense", "tcp://127.0.0.1"])
+def test_bad_scheduler_address_is_one_line_error(address):
+    with pytest.raises(ValueError, match=f"--scheduler '{address}': cannot connect"):
+        run_cases(echo_task, _cases(2), scheduler=address)
