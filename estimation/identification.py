@@ -66,10 +66,14 @@ def identify(flight, model="inverse", *, gps_noise_std_mps=None, ipopt_options=N
     IPOPT's status and `warnings` says so.
 
     "auto" uses the Bayesian information criterion with an effective sample size,
-    BIC = N_eff ln(RSS / N) + p ln(N_eff), N_eff = N R_vv(0) / sum_k w(k) R_vv(k) (the
-    residuals' long-run variance ratio, same lag window as the covariance). At 50 Hz the
-    residuals are correlated over hundreds of samples; the plain N would reward any extra
-    coefficient that fits turbulence.
+    BIC = N_eff ln(RSS / N) + p ln(N_eff), N_eff = N median_j(P_jj / C_jj) clipped to [1, N],
+    P the plain and C the colored-residual covariance of the lowest-RSS candidate, in the
+    solver's parameters: N divided by the variance inflation the reported bounds carry, so
+    the criterion and the bounds use one noise model. At 50 Hz the residuals are correlated
+    over hundreds of samples; the plain N would reward any extra coefficient that fits
+    turbulence. (A Bartlett long-run variance of the residuals, the earlier N_eff, made the
+    same choices on the test flights but counted about twice as many samples in turbulence,
+    because its taper underestimates the long-run variance.)
 
     Example
     -------
@@ -115,7 +119,8 @@ def identify(flight, model="inverse", *, gps_noise_std_mps=None, ipopt_options=N
     order = {name: i for i, name in enumerate(MODELS)}
     candidates.sort(key=lambda c: order[c["model"]])
     return dataclasses.replace(results[chosen], candidates=tuple(candidates),
-                               criterion="BIC with effective N (residual long-run variance)")
+                               criterion="BIC with effective N (N / variance inflation of the "
+                                         "colored-residual covariance)")
 
 
 def _identify_one(flight, model, gps_noise_std_mps, ipopt_options):
@@ -192,6 +197,21 @@ def _check_information(result):
 
 
 def _effective_n(result):
+    """N / the variance inflation of the colored-residual covariance (see `identify` Notes).
+
+    Falls back to the residuals' Bartlett long-run variance ratio when the covariance has no
+    finite positive diagonal (a solve that did not converge).
+    """
+    n = result.n_samples
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.diag(result.internal_covariance_plain) / np.diag(result.internal_covariance)
+    ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
+    if ratio.size:
+        return float(np.clip(n * np.median(ratio), 1.0, n))
+    return _effective_n_long_run(result)
+
+
+def _effective_n_long_run(result):
     from .covariance import lag_weights, residual_acf, truncation_lag
 
     r = result.residuals_pa

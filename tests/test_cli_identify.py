@@ -222,3 +222,20 @@ def test_plot_without_extension_is_png_and_named(flight_csv, tmp_path, capsys):
     assert main(["identify", str(path), "--plot", str(tmp_path / "fig")]) == 0
     assert f"Wrote {tmp_path / 'fig.png'}" in capsys.readouterr().out
     assert (tmp_path / "fig.png").read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("turbulence_mps, low, high", [(0.0, 0.95, 1.0), (0.5, 1e-4, 0.05)])
+def test_auto_effective_n_is_n_over_the_bounds_variance_inflation(turbulence_mps, low, high):
+    """N_eff of `--model auto` follows the corrected covariance: ~N in calm air, tiny in gusts."""
+    import numpy as np
+    from estimation import identify
+
+    flight, _ = synthetic_flight(seed=3, n=N, turbulence_mps=turbulence_mps)
+    result = identify(flight, "auto")
+    fits = {m: identify(flight, m) for m in ("constant", "linear", "inverse")}
+    best = min(fits.values(), key=lambda r: float(r.residuals_pa @ r.residuals_pa))
+    shrink = np.diag(best.internal_covariance_plain) / np.diag(best.internal_covariance)
+    n_eff = [c["n_eff"] for c in result.candidates]
+    assert n_eff == [pytest.approx(min(N, N * np.median(shrink)), rel=1e-9)] * 3
+    assert low * N <= n_eff[0] <= high * N
+    assert "variance inflation" in result.criterion
