@@ -6,6 +6,7 @@ summary. `rerun("coverage", 17, seed=0)` repeats run 17 of that study alone.
 """
 
 import importlib
+import inspect
 import importlib.util
 import json
 import logging
@@ -86,7 +87,8 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
         raise PitotcalError(f"runs must be a positive integer, got {runs!r}")
     out = Path(out_dir)
     if name in EXTERNAL_STUDIES and name not in STUDY_MODULES:
-        return _run_external(name, out, runs, seed)
+        return _run_external(name, out, runs, seed, quick=quick, workers=workers,
+                             scheduler=scheduler, progress=progress)
     study = get_study(name)
     out.mkdir(parents=True, exist_ok=True)
     n_rep = int(runs) if runs is not None else (study.quick_runs if quick else study.default_runs)
@@ -126,11 +128,14 @@ def rerun(name, run_index, *, runs=None, seed=0, quick=False):
     return run_one(study.task, study.cases(n_rep, quick), run_index, base_seed=seed)
 
 
-def _run_external(name, out, runs, seed):
+def _run_external(name, out, runs, seed, **options):
     module, function, takes_runs = EXTERNAL_STUDIES[name]
     fun = getattr(importlib.import_module(module), function)
     out.mkdir(parents=True, exist_ok=True)
     kwargs = {"seed": seed, **({"runs": runs} if runs is not None else {})} if takes_runs else {}
+    # pass where-to-run, --quick and progress on to the studies that take them (peers does)
+    accepted = inspect.signature(fun).parameters
+    kwargs.update({k: v for k, v in options.items() if k in accepted})
     summary = dict(fun(out, **kwargs))
     summary.setdefault("files", sorted(str(p) for p in out.glob(f"{name}*")))
     return summary

@@ -1,5 +1,7 @@
 """Peer baselines (studies/baselines.py) recover a known scale and wind on seeded flights."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -103,3 +105,42 @@ def test_compare_peers_one_run(tmp_path):
     e = by["pitotcal"]["240"]
     assert e["dv_rms_err_kt"] < 0.5 and e["dv_coverage"] == 1.0
     assert len(s["claims"]) == 4
+
+
+def test_compare_peers_inverse_truth_case(tmp_path):
+    """The second truth case (the paper's inverse+ model): pitotcal fits `inverse`, the peers
+    their single scale; both cases in one table, one summary, two figures."""
+    from studies.compare_peers import INVERSE_K, run_compare_peers
+    from studies.runner import read_table
+
+    s = run_compare_peers(tmp_path, runs=1, seed=3, times_s=(240.0,), workers=0)
+    for name in ("peers.csv", "peers.json", "peers.png", "peers-inverse.png"):
+        assert (tmp_path / name).is_file()
+    inv = s["inverse_truth"]
+    assert inv["truth_model"] == inv["fit_model"] == "inverse"
+    assert inv["truth_k"] == list(INVERSE_K)
+    assert s["truth_model"] == "constant" and s["n_runs"] == 2 and s["n_failed"] == 0
+    rows = read_table(tmp_path / "peers.csv")
+    assert {r["truth_model"] for r in rows} == {"constant", "inverse"}
+    # the truth ΔV of each case is that case's own model at 85 kt
+    ref = {r["truth_model"]: r["dv_true_kt"] for r in rows}
+    from studies.common import true_delta_v_kt
+    assert math.isclose(ref["inverse"], float(true_delta_v_kt("inverse", INVERSE_K, 85.0)))
+    assert math.isclose(ref["constant"], float(true_delta_v_kt("constant", (0.05,), 85.0)))
+    e = inv["by_method"]["pitotcal"]["240"]
+    assert e["estimates"] == 1 and e["dv_range_rms_err_kt"] < 0.5 and e["dv_range_coverage"] == 1.0
+    # a single scale cannot follow k2/q_ci: its ΔV error over the range is larger than at
+    # the reference speed, where a one-scale fit crosses the curve
+    for peer in ("ardupilot", "px4"):
+        p = inv["by_method"][peer]["240"]
+        assert p["dv_range_rms_err_kt"] > p["dv_rms_err_kt"]
+    assert len(inv["claims"]) == 4 and len(inv["claims_dv_range"]) == 2
+
+
+def test_range_score_uses_every_grid_point():
+    import numpy as np
+
+    from studies.compare_peers import _range_score
+    out = _range_score([1.0, 2.0, 3.0], [0.5, 0.5, 0.1], np.array([1.0, 2.2, 3.3]))
+    assert math.isclose(out["dv_range_err_max_kt"], 0.3)
+    assert out["dv_range_2sigma_max_kt"] == 0.5 and out["dv_range_covered"] is False
