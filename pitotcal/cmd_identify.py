@@ -28,6 +28,10 @@ def add_parser(subparsers):
                    help="use only samples with time_s >= S")
     p.add_argument("--end-s", type=float, default=None, metavar="S",
                    help="use only samples with time_s <= S")
+    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
+                   help="logs only: measured outside air temperature, degC, for density "
+                        "(default: the log's airspeed or baro sensor temperature, with a "
+                        "warning); a flight CSV carries its own rho_kgm3 or oat_k")
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
@@ -39,7 +43,8 @@ def run(args):
     import warnings
 
     from estimation.errors import PitotcalError
-    from estimation.flight import read_flight
+    from estimation.flight import LOG_EXTENSIONS, read_flight
+    from pitotcal.cmd_convert import oat_k_from_c
     from estimation import identify
     from estimation.models import MODELS
 
@@ -59,11 +64,21 @@ def run(args):
     if args.plot is not None:
         _check_plot_format(args.plot)
 
-    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s)
+    is_log = source.suffix.lower() in LOG_EXTENSIONS
+    if args.oat_c is not None and not is_log:
+        raise PitotcalError(f"--oat-c applies to .ulg/.bin/.log logs only; {source.name} is a "
+                            "flight CSV, whose density comes from its rho_kgm3 or ps_pa/oat_k")
+    oat_k = oat_k_from_c(args.oat_c)
+    if oat_k is not None:
+        from estimation.logs import read_log
+        flight = read_log(source, start_s=args.start_s, end_s=args.end_s, oat_k=oat_k)
+    else:
+        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s)
     result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
 
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
-          + (f", {flight.n_dropped} rows dropped" if flight.n_dropped else "") + ")")
+          + (f", {flight.n_dropped} {'samples cut' if is_log else 'rows dropped'}"
+             if flight.n_dropped else "") + ")")
     print(result.summary())
     if not result.converged:
         warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "

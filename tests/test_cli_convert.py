@@ -84,3 +84,50 @@ def test_identify_reads_the_sitl_log_directly(shared_data, tmp_path, capsys):
     result = json.loads(out.read_text())
     assert result["converged"] and result["parameters"]["wind_speed_mps"]["value"] < 1.0
     assert "sensor temperature, not OAT" in capsys.readouterr().err
+
+
+def test_identify_on_a_log_takes_the_oat(tmp_path, flight, capsys):
+    """--oat-c reaches the log reader (no sensor-temperature warning, density from it)."""
+    log = write_dataflash_bin(tmp_path / "f.bin", flight, gps_invalid=(50.0, 60.0))
+    out = tmp_path / "r.json"
+    assert main(["identify", str(log), "--model", "constant", "--oat-c", "20",
+                 "--json", str(out)]) == 0
+    cap = capsys.readouterr()
+    assert cap.err == "" and "samples cut)" in cap.out.splitlines()[0]
+    d = json.loads(out.read_text())
+    assert d["converged"] and d["model"] == "constant"
+    rho = 97000.0 / (287.05287 * 293.15)         # the writer's static pressure at 20 degC
+    k1_true = 1.0 - (1.0 - 0.03) * flight.rho_kgm3[0] / rho   # k1 absorbs the density
+    k1 = d["parameters"]["k1"]
+    assert abs(k1["value"] - k1_true) < 3 * k1["std"] + 1e-3
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--oat-c", "288"], r"--oat-c 288: not an outside air temperature in degC .*looks like "
+     "kelvin"),
+    (["--oat-c", "-200"], r"--oat-c -200: not an outside air temperature in degC"),
+    (["-o", "nodir/out.csv"], r"-o .*nodir/out\.csv: directory .*nodir does not exist"),
+])
+def test_convert_option_errors_exit_2_before_reading(tmp_path, flight, capsys, args, match):
+    import re
+
+    log = write_dataflash_bin(tmp_path / "f.bin", flight)
+    args = [str(tmp_path / a) if a.endswith(".csv") else a for a in args]
+    if "-o" not in args:
+        args += ["-o", str(tmp_path / "out.csv")]
+    assert main(["convert", str(log), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and re.search(match, err), err
+    assert not (tmp_path / "out.csv").exists()
+
+
+def test_identify_refuses_oat_c_for_a_csv_and_kelvin(tmp_path, flight, capsys):
+    from estimation.flight import write_flight_csv
+
+    path = write_flight_csv(flight, tmp_path / "f.csv")
+    assert main(["identify", str(path), "--oat-c", "15"]) == 2
+    assert "--oat-c applies to .ulg/.bin/.log logs only; f.csv is a flight CSV" in \
+        capsys.readouterr().err
+    log = write_dataflash_bin(tmp_path / "f.bin", flight)
+    assert main(["identify", str(log), "--oat-c", "290"]) == 2
+    assert "looks like kelvin" in capsys.readouterr().err
