@@ -6,8 +6,8 @@ summary. `rerun("coverage", 17, seed=0)` repeats run 17 of that study alone.
 """
 
 import importlib
-import inspect
 import importlib.util
+import inspect
 import json
 import logging
 import math
