@@ -159,6 +159,8 @@ def _residual_figure(result, out):
     s = max(float(result.noise_std_pa), 1e-9)
     ax[0, 1].plot(x, np.exp(-0.5 * (x / s) ** 2) / (s * np.sqrt(2 * np.pi)), "k-", lw=1)
     ax[0, 1].set_xlabel("q_ci residual, Pa")
+    ax[0, 1].set_ylabel("probability density, 1/Pa")
+    ax[0, 1].set_title("histogram and the normal of the same rms")
     return Path(save(fig, out, "residuals.png"))
 
 

@@ -101,6 +101,7 @@ def plot(rows, summary, out_dir):
     a.set_xscale("log")
     a.set_yscale("log")
     a.set_xlabel("samples used")
+    a.set_ylabel("2σ of the wind, deg or m/s (median)")
     a.legend(fontsize=7)
     a = ax[1, 2]
     a.plot(ns, [by_n[str(n)]["dv_2sigma_max_kt"] for n in ns], "o-", label="2σ of ΔV (max), kt")
@@ -110,6 +111,7 @@ def plot(rows, summary, out_dir):
     a.set_xscale("log")
     a.set_yscale("log")
     a.set_xlabel("samples used")
+    a.set_ylabel("ΔV, kt")
     a.legend(fontsize=7)
     fig.suptitle("Effect of sample size, S-2-like two-speed flight (70/90 KCAS, 50 Hz)")
     return [save(fig, out_dir, "sample-size.png")]

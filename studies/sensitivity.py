@@ -22,7 +22,8 @@ FACTORS = {
     "gps_rate_hz": ("sim", "gps_rate_hz", (1.0, 2.0, 5.0, 10.0, 20.0), "GPS rate, Hz"),
     "qc_noise_pa": ("sim", "qc_noise_pa", (0.1, 0.5, 1.0, 2.0, 5.0), "transducer noise, Pa"),
     "qc_bias_pa": ("sim", "qc_bias_pa", (0.0, 1.0, 2.0, 5.0, 10.0), "transducer bias, Pa"),
-    "qc_scale_error": ("sim", "qc_scale_error", (0.0, 0.005, 0.01, 0.02), "transducer scale error"),
+    "qc_scale_error": ("sim", "qc_scale_error", (0.0, 0.005, 0.01, 0.02),
+                       "transducer scale error, fraction of q_c"),
     "turbulence_mps": ("sim", "turbulence_mps", (0.0, 0.25, 0.5, 1.0, 2.0), "turbulence σ, m/s"),
     "rate_hz": ("sim", "rate_hz", (5.0, 10.0, 25.0, 50.0, 100.0, 200.0), "data rate, Hz"),
     "wind_drift_mps2": ("sim", "wind_drift_mps2", (0.0, 0.002, 0.005, 0.01, 0.02),
@@ -96,7 +97,8 @@ def plot(rows, summary, out_dir):
         a.legend(fontsize=7)
     for a in list(ax.flat)[len(factors):]:
         a.set_visible(False)
-    ax[0, 0].set_ylabel("kt (largest over the speed range)")
+    for row in ax:
+        row[0].set_ylabel("ΔV, kt (largest over the speed range)")
     fig.suptitle("Sensitivity of the T-2 calibration, one factor at a time (dotted: 0.2 kt)")
     return [save(fig, out_dir, "sensitivity.png")]
 
