@@ -100,3 +100,22 @@ def test_study_full_size(name, tmp_path):
     if name == "coverage":
         assert 0.90 <= summary["coverage_2sigma"] <= 0.98
         assert summary["coverage_2sigma_uncorrected"] < summary["coverage_2sigma"]
+
+
+@pytest.mark.slow
+def test_peers_full_size(tmp_path):
+    """`pitotcal study peers` at full size (10 flights per truth case, 30-600 s): pitotcal's
+    wind is honest within 0.5 m/s well before the filters', and in the inverse case the peers'
+    single scale is structurally biased at the ends of the flown range."""
+    summary = run_study("peers", out_dir=tmp_path)
+    assert summary["n_failed"] == 0, summary["errors"]
+    assert {"peers.csv", "peers.json", "peers.png", "peers-inverse.png"} <= {
+        p.name for p in tmp_path.iterdir()}
+    for case in (summary, summary["inverse_truth"]):
+        ours = case["by_method"]["pitotcal"]["600"]
+        assert ours["dv_coverage"] >= 0.8 and ours["wind_coverage"] >= 0.8
+        assert case["time_to_tolerance_s"]["pitotcal"]["wind"] is not None
+        assert case["time_to_tolerance_s"]["px4"]["wind"] is None
+    inv = summary["inverse_truth"]["by_method"]
+    for peer in ("ardupilot", "px4"):
+        assert inv[peer]["600"]["dv_range_rms_err_kt"] > inv[peer]["600"]["dv_rms_err_kt"]
