@@ -123,6 +123,9 @@ def rerun(name, run_index, *, runs=None, seed=0, quick=False):
 
     Give the same `runs`, `seed` and `quick` as the study, so the cases line up.
     """
+    if name in EXTERNAL_STUDIES and name not in STUDY_MODULES:
+        raise PitotcalError(f"--run-index is not available for study {name!r}; repeat one "
+                            f"flight with --runs 1 --seed S+I instead")
     study = get_study(name)
     n_rep = int(runs) if runs is not None else (study.quick_runs if quick else study.default_runs)
     return run_one(study.task, study.cases(n_rep, quick), run_index, base_seed=seed)

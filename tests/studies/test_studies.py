@@ -119,3 +119,8 @@ def test_peers_full_size(tmp_path):
     inv = summary["inverse_truth"]["by_method"]
     for peer in ("ardupilot", "px4"):
         assert inv[peer]["600"]["dv_range_rms_err_kt"] > inv[peer]["600"]["dv_rms_err_kt"]
+
+
+def test_rerun_of_external_study_says_why():
+    with pytest.raises(ValueError, match="--run-index is not available for study 'peers'"):
+        rerun("peers", 1)
