@@ -12,6 +12,8 @@ import numpy as np
 __all__ = ["plain_covariance", "colored_covariance", "ColoredCovariance", "residual_acf",
            "truncation_lag", "to_reported"]
 
+# Fewer independent stretches (N / 2 tau) than this: warn that the bounds are rough.
+MIN_STRETCHES = 10
 # A lag window shorter than this cannot describe even sample-and-hold GPS at 5 Hz in 50 Hz data.
 MIN_LAG = 10
 
@@ -150,10 +152,14 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None, inform
     m_inv = _inv_sym(jac.T @ jac if information is None else information)
     middle = jac.T @ hs
     cov = m_inv @ (0.5 * (middle + middle.T)) @ m_inv
+    # correlation time, samples: of the fitted decay, or half the window
+    tau = -1.0 / np.log(a) if window == "exponential" and 0.0 < a < 1.0 else lag / 2.0
+    stretches = n / max(2.0 * tau, 1.0)
     warning = None
-    if lag >= n // 4:
-        warning = (f"residuals correlated over {lag} samples, a quarter of the data: the corrected "
-                   "bounds are themselves uncertain; fly longer")
+    if stretches < MIN_STRETCHES:
+        warning = (f"residuals correlated over ~{2 * tau:.0f} samples: only ~{stretches:.0f} "
+                   "independent stretches of data, so the corrected bounds are themselves "
+                   f"uncertain by ~{100 / np.sqrt(max(stretches, 1.0)):.0f}%; fly longer")
     return ColoredCovariance(cov, lag, window, a, warning)
 
 
@@ -168,6 +174,7 @@ def to_reported(n_coef, theta, cov):
     wn, we = theta[n_coef], theta[n_coef + 1]
     speed = float(np.hypot(wn, we))
     from_deg = float(np.degrees(np.arctan2(-we, -wn)) % 360.0)
+    from_deg = 0.0 if from_deg >= 360.0 else from_deg     # -1e-16 % 360 rounds to 360.0
     s2 = max(speed * speed, 1e-24)
     jac = np.eye(theta.size)
     jac[n_coef, n_coef:] = [wn / max(speed, 1e-12), we / max(speed, 1e-12)]

@@ -102,3 +102,8 @@ def test_reported_sigma_matches_the_scatter_of_estimates_under_projection():
     assert np.all(ratio > 0.85) and np.all(ratio < 1.2), ratio          # measured 1.00, 0.98
     inside = np.abs(np.array(estimates)) < 2 * np.array(sigmas)
     assert np.all(inside.mean(axis=0) >= 0.88) and inside.mean() <= 0.99, inside.mean(axis=0)
+
+
+def test_wind_from_stays_below_360():
+    params, _ = to_reported(1, np.array([0.02, -5.0, 1e-16]), np.eye(3) * 1e-4)
+    assert 0.0 <= params[2] < 360.0
