@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .units import wind_polar
+
 __all__ = ["plain_covariance", "colored_covariance", "ColoredCovariance", "residual_acf",
            "truncation_lag", "to_reported"]
 
@@ -172,9 +174,7 @@ def to_reported(n_coef, theta, cov):
     """
     theta = np.asarray(theta, dtype=float)
     wn, we = theta[n_coef], theta[n_coef + 1]
-    speed = float(np.hypot(wn, we))
-    from_deg = float(np.degrees(np.arctan2(-we, -wn)) % 360.0)
-    from_deg = 0.0 if from_deg >= 360.0 else from_deg     # -1e-16 % 360 rounds to 360.0
+    speed, from_deg = map(float, wind_polar(wn, we))
     s2 = max(speed * speed, 1e-24)
     jac = np.eye(theta.size)
     jac[n_coef, n_coef:] = [wn / max(speed, 1e-12), we / max(speed, 1e-12)]

@@ -65,7 +65,7 @@ import numpy as np
 
 from .errors import FlightDataError, PitotcalError
 from .flight import Flight
-from .units import density_kgm3, isa_pressure_pa, isa_temperature_k
+from .units import density_kgm3, isa_pressure_pa, isa_temperature_k, wind_polar
 
 __all__ = ["read_log", "load_log", "FlightLog", "AutopilotWind", "LOG_EXTENSIONS"]
 
@@ -167,7 +167,7 @@ class AutopilotWind:
     @property
     def from_deg(self):
         """Direction the wind blows FROM, deg true, [0, 360)."""
-        return np.degrees(np.arctan2(-self.wind_e_mps, -self.wind_n_mps)) % 360.0
+        return wind_polar(self.wind_n_mps, self.wind_e_mps)[1]
 
 
 @dataclass(frozen=True)
@@ -464,7 +464,7 @@ def _assemble(s, name, start_s, end_s, gps_resample, gps_latency_s, min_gs, min_
         if inside.any():
             wn, we = wind.wind_n_mps[inside].mean(), wind.wind_e_mps[inside].mean()
             meta["autopilot_wind"] = (f"{wind.source}, mean {np.hypot(wn, we):.2f} m/s from "
-                                      f"{np.degrees(np.arctan2(-we, -wn)) % 360:.0f} deg")
+                                      f"{wind_polar(wn, we)[1]:.0f} deg")
     flight = Flight(time_s=kt, qci_pa=q[keep], gps_vn_mps=vn[keep], gps_ve_mps=ve[keep],
                     rho_kgm3=rho[keep],
                     gps_vd_mps=vd[keep] if s.gps_vd is not None else None,

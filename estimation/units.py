@@ -10,6 +10,7 @@ __all__ = [
     "kt_to_mps", "mps_to_kt", "ft_to_m", "m_to_ft",
     "density_kgm3", "cas_from_qc_mps", "qc_from_cas_pa",
     "isa_temperature_k", "isa_pressure_pa", "isa_density_kgm3",
+    "wind_vector_mps", "wind_polar",
 ]
 
 KT_TO_MPS = 1852.0 / 3600.0          # international knot
@@ -39,6 +40,19 @@ def m_to_ft(h_m):
 def density_kgm3(ps_pa, oat_k):
     """Air density from static pressure and outside air temperature, rho = p / (R T)."""
     return np.asarray(ps_pa, dtype=float) / (R_AIR_JKGK * np.asarray(oat_k, dtype=float))
+
+
+def wind_vector_mps(speed_mps, from_deg):
+    """(north, east) air-mass velocity, m/s, of a wind blowing FROM `from_deg` (deg true)."""
+    a = np.radians(from_deg)
+    return -np.multiply(speed_mps, np.cos(a)), -np.multiply(speed_mps, np.sin(a))
+
+
+def wind_polar(wind_n_mps, wind_e_mps):
+    """(speed_mps, from_deg in [0, 360)) of an air-mass velocity (the way it blows TO)."""
+    speed = np.hypot(wind_n_mps, wind_e_mps)
+    from_deg = np.degrees(np.arctan2(-np.asarray(wind_e_mps), -np.asarray(wind_n_mps))) % 360.0
+    return speed, np.where(from_deg >= 360.0, 0.0, from_deg)[()]   # -1e-16 % 360 -> 360.0
 
 
 def cas_from_qc_mps(qc_pa):

@@ -25,7 +25,7 @@ import numpy as np
 
 from estimation.errors import PitotcalError
 from estimation.flight import Flight
-from estimation.units import RHO0_KGM3
+from estimation.units import RHO0_KGM3, wind_polar
 
 __all__ = [
     "BaselineTrack", "ardupilot_autocal", "px4_wind_estimator",
@@ -100,7 +100,7 @@ class BaselineTrack:
 
     @property
     def wind_from_deg(self):
-        return np.degrees(np.arctan2(-self.wind_e_mps, -self.wind_n_mps)) % 360.0
+        return wind_polar(self.wind_n_mps, self.wind_e_mps)[1]
 
     def index_at(self, t_s):
         """Index of the last update at or before `t_s` (−1 when there is none yet)."""

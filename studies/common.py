@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 
 from estimation.models import get_model, qc_from_qci_pa
-from estimation.units import RHO0_KGM3, kt_to_mps, mps_to_kt
+from estimation.units import RHO0_KGM3, kt_to_mps, mps_to_kt, wind_polar
 
 __all__ = ["T2_PLAN", "get_plan", "fly", "identify_flight", "score", "true_delta_v_kt",
            "wrap_deg", "first_seconds", "truth_for", "run_fly_identify", "Study", "ok_rows", "column",
@@ -70,8 +70,9 @@ def truth_for(truth, flight):
     if not pick.any():
         return truth
     wn, we = np.mean(np.asarray(hist["wind_n_mps"])[pick]), np.mean(np.asarray(hist["wind_e_mps"])[pick])
-    params = {**truth["parameters"], "wind_speed_mps": float(np.hypot(wn, we)),
-              "wind_from_deg": float(np.degrees(np.arctan2(-we, -wn)) % 360.0)}
+    speed, from_deg = wind_polar(wn, we)
+    params = {**truth["parameters"], "wind_speed_mps": float(speed),
+              "wind_from_deg": float(from_deg)}
     return {**truth, "parameters": params}
 
 

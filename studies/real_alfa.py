@@ -34,7 +34,7 @@ import numpy as np
 
 from estimation.errors import FlightDataError, PitotcalError
 from estimation.flight import Flight
-from estimation.units import RHO0_KGM3, R_AIR_JKGK, isa_temperature_k, mps_to_kt
+from estimation.units import RHO0_KGM3, R_AIR_JKGK, isa_temperature_k, mps_to_kt, wind_polar
 
 from .baselines import (ardupilot_autocal, ardupilot_ratio_from_k1, k1_from_ardupilot_ratio,
                         px4_wind_estimator)
@@ -302,13 +302,13 @@ def run_real_alfa(out_dir, *, data_dir=None, oat="autopilot", plot=True):
     wn = -np.mean(ap_wind_speed * np.cos(np.radians(ap_wind_from)))
     we = -np.mean(ap_wind_speed * np.sin(np.radians(ap_wind_from)))
     ap_mean_speed = float(np.hypot(wn, we))
-    ap_mean_from = float(np.degrees(np.arctan2(-we, -wn)) % 360.0)
+    ap_mean_from = float(wind_polar(wn, we)[1])
     # the autopilot's wind starts far off (7.9 m/s) and settles: compare with the second half too
     late = ap["wind_t"][w_seg] >= 0.5 * (seg[0] + seg[1])
     wn_l = -np.mean(ap_wind_speed[late] * np.cos(np.radians(ap_wind_from[late])))
     we_l = -np.mean(ap_wind_speed[late] * np.sin(np.radians(ap_wind_from[late])))
     ap_late_speed = float(np.hypot(wn_l, we_l))
-    ap_late_from = float(np.degrees(np.arctan2(-we_l, -wn_l)) % 360.0)
+    ap_late_from = float(wind_polar(wn_l, we_l)[1])
 
     ardu = ardupilot_autocal(flight, initial_ratio=ap_ratio)
     px4 = px4_wind_estimator(flight)
