@@ -101,3 +101,51 @@ def test_cli_refuses_infeasible_requests(argv, message, tmp_path, capsys):
     assert err.startswith("pitotcal plan: ") and message in err
     assert err.count("\n") == 1 and "Traceback" not in err
     assert not out.exists()
+
+
+def _broken(text, row, new):
+    """The plan CSV text with data row `row` (1-based) replaced by `new` (None: dropped)."""
+    lines = text.splitlines()
+    first = next(i for i, line in enumerate(lines) if not line.startswith("#")) + 1
+    if new is None:
+        del lines[first + row - 1]
+    else:
+        lines[first + row - 1] = new(lines[first + row - 1].split(","))
+    return "\n".join(lines) + "\n"
+
+
+BROKEN_PLANS = [
+    (5, lambda c: ",".join([c[0], "abc", *c[2:]]), r"column north_m, row 5 \(line \d+\): "
+                                                    r"not a number: 'abc'"),
+    (7, lambda c: ",".join([c[0], c[1], "nan", *c[3:]]), r"column east_m, row 7 \(line \d+\): nan"),
+    (9, lambda c: ",".join(["0.000", *c[1:]]), r"column time_s, row 9 \(line \d+\): 0 s is not "
+                                               r"after the previous row's [\d.]+ s"),
+    (4, lambda c: ",".join(c[:3]), r"row 4 \(line \d+\): 3 cells, the header has 9"),
+    (6, lambda c: ",".join([*c[:7], "-3", c[8]]), r"column cas_mps, row 6 \(line \d+\): "
+                                                  r"airspeed -3 m/s must be > 0"),
+]
+
+
+@pytest.mark.parametrize("row, edit, match", BROKEN_PLANS)
+def test_read_plan_names_file_column_and_row(plan, tmp_path, row, edit, match):
+    from estimation.errors import PitotcalError
+
+    good = write_plan_outputs(plan, tmp_path / "good.csv", figures=False)["plan"]
+    bad = tmp_path / "bad.csv"
+    bad.write_text(_broken(good.read_text(), row, edit))
+    with pytest.raises(PitotcalError, match=rf"bad.csv: {match}"):
+        read_plan(bad)
+
+
+def test_read_plan_bom_crlf_and_truncation_warning(plan, tmp_path):
+    good = write_plan_outputs(plan, tmp_path / "good.csv", figures=False)["plan"]
+    text = good.read_text()
+    crlf = tmp_path / "crlf.csv"
+    crlf.write_bytes(b"\xef\xbb\xbf" + text.replace("\n", "\r\n").encode())
+    back = read_plan(crlf)
+    assert back.n == plan.n and back.settings == plan.settings
+    cut = tmp_path / "cut.csv"
+    cut.write_text("\n".join(text.splitlines()[:-100]) + "\n")
+    with pytest.warns(UserWarning, match=r"cut.csv: the plan spans [\d.]+ s but its settings "
+                                         r"say duration_s 240 s: is the file truncated\?"):
+        assert read_plan(cut).n == plan.n - 100
