@@ -25,11 +25,15 @@ from maneuvers.plan import Plan
 from maneuvers.sensors import gps_velocity_sensor, impact_pressure_sensor
 from maneuvers.turbulence import dryden_gusts, dryden_scales
 
-__all__ = ["simulate", "write_truth_json", "truth_path_for", "GUIDANCE_GAINS"]
+__all__ = ["simulate", "write_truth_json", "truth_path_for", "GUIDANCE_GAINS", "MAX_SAMPLES"]
 
 # Lateral guidance: desired ground track = the path's direction + K_pos * distance to the path
 # (1/s); heading loop K_psi (1/s). K_pos is slow (time constant 20 s) so turbulence does not make
 # the bank busy; K_psi keeps a 10 deg heading error below a 20 deg bank correction at 45 m/s.
+# Memory grows with the samples (~1.5 kB each in the scalar loop, measured: 1.5 GB peak and
+# 13 s for 10^6): 500,000 is 2.8 h at 50 Hz, or 42 min at 200 Hz.
+MAX_SAMPLES = 500_000
+
 GUIDANCE_GAINS = {"k_pos_per_s": 1.0 / 20.0, "k_psi_per_s": 0.4, "k_alt_per_s": 0.2}
 
 
@@ -151,6 +155,15 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     gps_rate_hz = _finite("gps_rate_hz", gps_rate_hz or 0.0, 0.0)
     gps_noise_mps = _finite("gps_noise_mps", gps_noise_mps, 0.0)
     gps_latency_s = _finite("gps_latency_s", gps_latency_s, 0.0)
+    span_s = float(plan.time_s[-1] - plan.time_s[0])
+    if span_s * rate_hz + 1 > MAX_SAMPLES:
+        raise PitotcalError(
+            f"rate_hz {rate_hz:g} gives {span_s * rate_hz + 1:.3g} samples over the plan's "
+            f"{span_s:g} s; the simulator records at most {MAX_SAMPLES:,}: use rate_hz <= "
+            f"{math.floor((MAX_SAMPLES - 1) / span_s):g}")
+    if gps_latency_s >= span_s:
+        raise PitotcalError(f"gps_latency_s {gps_latency_s:g} must be shorter than the plan's "
+                            f"{span_s:g} s (typical receivers: 0-0.5 s)")
     if not isinstance(seed, (int, np.integer)) or seed < 0:
         raise PitotcalError(f"seed must be an integer >= 0, got {seed!r}")
     if limits is None:

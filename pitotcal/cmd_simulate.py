@@ -43,12 +43,13 @@ def add_parser(subparsers):
 
 def run(args):
     import logging
+    from pathlib import Path
 
     from estimation.errors import PitotcalError
     from estimation.flight import write_flight_csv
     from estimation.models import get_model
     from maneuvers.plan import read_plan
-    from maneuvers.simulator import simulate, write_truth_json
+    from maneuvers.simulator import simulate, truth_path_for, write_truth_json
 
     try:
         model = get_model(args.model)
@@ -61,6 +62,15 @@ def run(args):
                 raise PitotcalError(f"--k{i + 1}: model {model.name!r} has only "
                                     f"{len(model.params)} coefficient(s)")
             k[i] = value
+    # The input is never modified: refuse outputs that would overwrite the plan, and keep the
+    # truth beside the flight even when the flight's name ends in .json.
+    out, truth_out = Path(args.output), truth_path_for(args.output)
+    if out.suffix.lower() == ".json":
+        raise PitotcalError(f"-o {args.output}: the flight is a CSV; name it FLIGHT.csv "
+                            f"(the truth goes to {truth_out.name})")
+    for path in (out, truth_out):
+        if path.exists() and Path(args.plan).exists() and path.samefile(args.plan):
+            raise PitotcalError(f"-o {args.output}: would overwrite the plan {args.plan}")
     plan = read_plan(args.plan)
     flight, truth = simulate(
         plan, seed=args.seed, model=model.name, k=tuple(k), wind_speed_mps=args.wind_speed_mps,
@@ -74,7 +84,7 @@ def run(args):
         gps_latency_s=args.gps_latency_s)
     comments = {"plan": str(args.plan)}
     write_flight_csv(flight, args.output, comments=comments)
-    truth_path = write_truth_json(truth, args.output)
+    truth_path = write_truth_json(truth, truth_out)
     tr = truth["tracking"]
     par = truth["parameters"]
     logging.getLogger(__name__).info("CAS error max %.2f kt, max radius %.0f m",

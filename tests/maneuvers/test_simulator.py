@@ -306,3 +306,31 @@ def test_monte_carlo_default_plan_tracking_and_coverage():
             inside += abs(result.params[i] - true[name]) < 3.0 * result.std[i]
             total += 1
     assert inside / total >= 0.9
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"rate_hz": 1e9}, r"rate_hz 1e\+09 gives 2.4e\+11 samples over the plan's 240 s; the "
+                       r"simulator records at most 500,000: use rate_hz <= 2083"),
+    ({"gps_latency_s": 240.0}, r"gps_latency_s 240 must be shorter than the plan's 240 s"),
+])
+def test_impossible_sizes_refused_before_any_work(plan, kwargs, match):
+    with pytest.raises(PitotcalError, match=match):
+        simulate(plan, **kwargs)
+
+
+def test_cli_never_overwrites_the_plan_and_keeps_truth_beside(tmp_path, plan, capsys):
+    from pitotcal.cli import main
+
+    plan_path = write_plan(plan, tmp_path / "plan.csv")
+    before = plan_path.read_bytes()
+    assert main(["simulate", str(plan_path), "-o", str(plan_path)]) == 2
+    assert main(["simulate", str(plan_path), "-o", str(tmp_path / "f.json")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and "would overwrite the plan" in err[0]
+    assert "the flight is a CSV" in err[1] and "f.truth.json" in err[1]
+    # a plan named like a truth file is not overwritten by the truth either
+    odd = tmp_path / "x.truth.json"
+    odd.write_bytes(before)
+    assert main(["simulate", str(odd), "-o", str(tmp_path / "x.csv")]) == 2
+    assert plan_path.read_bytes() == before == odd.read_bytes()
+    assert not (tmp_path / "f.json").exists() and not (tmp_path / "x.csv").exists()
