@@ -27,11 +27,14 @@ from maneuvers.plan import Plan
 from maneuvers.profiles import PROFILES, make_schedule
 
 __all__ = ["ManeuverProblem", "PathSolution", "plan_maneuver", "wind_vector_mps",
-           "turn_radius_m"]
+           "turn_radius_m", "MAX_NODES"]
 
 log = logging.getLogger(__name__)
 
 TURNS = {"right": 1.0, "left": -1.0}
+# IPOPT's time grows a little faster than the node count (measured: 240 nodes 0.2 s, 1,200 6 s,
+# 2,400 19 s, 24,000 more than 5 min); beyond this a plan is refused with the dt_s that works.
+MAX_NODES = 3000
 _KM = 1000.0          # position scale
 _PSI = 10.0           # heading scale (unwrapped heading reaches ~20 rad)
 _P = 0.1              # roll-rate scale, rad/s
@@ -268,7 +271,9 @@ def _check_float(name, value, lo=-np.inf, hi=np.inf, lo_open=False):
         value = float(value)
     except (TypeError, ValueError):
         raise PitotcalError(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(value) or value < lo or value > hi or (lo_open and value == lo):
+    if not np.isfinite(value):
+        raise PitotcalError(f"{name} {value:g} must be a finite number")
+    if value < lo or value > hi or (lo_open and value == lo):
         rule = f"> {lo:g}" if lo_open else f">= {lo:g}"
         if np.isfinite(hi):
             rule += f" and <= {hi:g}"
@@ -377,6 +382,16 @@ def plan_maneuver(profile="continuous", cas_min_kt=70.0, cas_max_kt=100.0, radiu
     heading_margin = np.radians(_check_float("heading_margin_deg", heading_margin_deg, 0.0))
     if int(levels) != levels or levels < 2:
         raise PitotcalError(f"levels {levels} must be an integer >= 2")
+    n_nodes = duration_s / dt_s
+    if n_nodes > MAX_NODES:
+        raise PitotcalError(
+            f"dt_s {dt_s:g} s over duration_s {duration_s:g} s gives {n_nodes:.0f} plan nodes; "
+            f"the planner takes at most {MAX_NODES} (about half a minute): use dt_s >= "
+            f"{np.ceil(duration_s / MAX_NODES * 100) / 100:g} s (the simulator flies "
+            f"between the nodes)")
+    if n_nodes > 1000:
+        log.warning("planning %.0f nodes: this takes %.0f-%.0f s", n_nodes,
+                    n_nodes / 250, n_nodes / 120)
     bank_max = np.radians(bank_max_deg)
 
     def schedule_for(duration):

@@ -187,6 +187,9 @@ BAD_ARGS = [
     ({"wind_speed_mps": float("nan")}, r"wind_speed_mps nan must be"),
     ({"turn": "up"}, r"turn 'up' is not one of"),
     ({"levels": 1, "profile": "step-pause"}, r"levels 1 must be an integer >= 2"),
+    ({"wind_from_deg": float("inf")}, r"wind_from_deg inf must be a finite number"),
+    ({"dt_s": 0.01}, r"dt_s 0.01 s over duration_s 240 s gives 24000 plan nodes; the planner "
+                     r"takes at most 3000 .*: use dt_s >= 0.08 s"),
 ]
 
 
