@@ -36,6 +36,16 @@ def _cue_indices(plan, cue_s):
     return np.array(sorted(marks))
 
 
+def _heading_cue(plan, k):
+    """Heading at node k, degrees true, rounded to 5° (the plan's heading is unwrapped)."""
+    return (round(plan.heading_deg[k] / 5.0) * 5) % 360
+
+
+def _bearing_deg(plan, k):
+    """Bearing of the aircraft from the test-area centre at node k, degrees true."""
+    return float(np.degrees(np.arctan2(plan.east_m[k], plan.north_m[k])) % 360.0)
+
+
 def _bank_cue(bank_deg):
     if abs(bank_deg) < 0.5:
         return "level"
@@ -82,8 +92,12 @@ def pilot_card_text(plan, cue_s=15.0):
         f"stay within {m_to_ft(s.get('radius_m', np.nan)):.0f} ft of centre",
         f"Turns {s.get('turn', 'right')}, bank max {s.get('bank_max_deg', '?')}° | "
         f"expected wind {s.get('wind_from_deg', 0):03.0f}° / {wind_kt:.0f} kt",
+        f"Start {m_to_ft(np.hypot(plan.north_m[0], plan.east_m[0])):.0f} ft from centre on "
+        f"bearing {_bearing_deg(plan, 0):03.0f}°, heading {_heading_cue(plan, 0):03.0f}°, "
+        f"{_bank_cue(plan.bank_deg[0])}, {mps_to_kt(plan.cas_mps[0]):.0f} KCAS",
+        "HDG: heading flown, °true | FROM CTR: distance and bearing from the centre",
         "",
-        f"{'TIME':>5}  {'KCAS':>9}  {'BANK':>5}  {'HDG':>4}  {'FROM CTR':>9}  SPEED CUE",
+        f"{'TIME':>5}  {'KCAS':>9}  {'BANK':>5}  {'HDG':>4}  {'FROM CTR':>14}  SPEED CUE",
     ]
     accel = np.diff(plan.tas_mps) / np.diff(plan.time_s)
     kcas_rate = np.diff(mps_to_kt(plan.cas_mps)) / np.diff(plan.time_s)
@@ -91,9 +105,9 @@ def pilot_card_text(plan, cue_s=15.0):
         t = plan.time_s[k] - plan.time_s[0]
         kcas = float(mps_to_kt(plan.cas_mps[k]))
         dist_ft = float(m_to_ft(np.hypot(plan.north_m[k], plan.east_m[k])))
-        hdg = (round(plan.heading_deg[k] / 5.0) * 5) % 360
         lines.append(f"{int(t // 60):2d}:{int(t % 60):02d}  {kcas:5.1f}±{_TOL_KT:.0f}  "
-                     f"{_bank_cue(plan.bank_deg[k]):>5}  {hdg:03.0f}°  {dist_ft:6.0f} ft  "
+                     f"{_bank_cue(plan.bank_deg[k]):>5}  {_heading_cue(plan, k):03.0f}°  "
+                     f"{dist_ft:6.0f} ft {_bearing_deg(plan, k):03.0f}°  "
                      f"{_speed_cue(plan, k, accel, kcas_rate)}")
     return "\n".join(lines) + "\n"
 

@@ -149,3 +149,12 @@ def test_read_plan_bom_crlf_and_truncation_warning(plan, tmp_path):
     with pytest.warns(UserWarning, match=r"cut.csv: the plan spans [\d.]+ s but its settings "
                                          r"say duration_s 240 s: is the file truncated\?"):
         assert read_plan(cut).n == plan.n - 100
+
+
+def test_pilot_card_gives_where_to_start_and_bearings(plan):
+    text = pilot_card_text(plan)
+    start_ft = np.hypot(plan.north_m[0], plan.east_m[0]) / 0.3048
+    bearing = np.degrees(np.arctan2(plan.east_m[0], plan.north_m[0])) % 360
+    assert f"Start {start_ft:.0f} ft from centre on bearing {bearing:03.0f}°" in text
+    first = next(line for line in text.splitlines() if line.startswith(" 0:00"))
+    assert f"{start_ft:6.0f} ft {bearing:03.0f}°" in first
