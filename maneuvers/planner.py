@@ -405,11 +405,16 @@ def plan_maneuver(profile="continuous", cas_min_kt=70.0, cas_max_kt=100.0, radiu
         raise PlanInfeasibleError(
             f"wind_speed_mps {wind_speed_mps:g} is too strong to hold position at "
             f"{cas_min_kt:g} KCAS: it must be below {0.9 * tas_min:.1f} m/s")
-    where = "dwell" if profile == "two-speed" else "third of the q range"
+    where = "dwell" if len(schedule.levels_qc_pa) == 2 else "third of the q range"
     if _turn_available(schedule, bank_max) < 2 * np.pi + heading_margin:
         lo, hi = duration_s, 2.0 * duration_s
         while _turn_available(schedule_for(hi), bank_max) < 2 * np.pi + heading_margin:
             lo, hi = hi, 2.0 * hi
+            if hi > 64.0 * duration_s:
+                # a group whose time does not grow with the duration: no duration helps
+                raise PlanInfeasibleError(
+                    f"no duration lets the track turn 360° in each {where} at "
+                    f"{bank_max_deg:g}° bank: try a larger bank_max_deg")
         while hi - lo > 0.5:
             mid = 0.5 * (lo + hi)
             ok = _turn_available(schedule_for(mid), bank_max) >= 2 * np.pi + heading_margin

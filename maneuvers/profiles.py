@@ -203,8 +203,9 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
     cas = cas_from_qc_mps(qc)
     tas = cas * tas_per_cas
     accel = np.diff(tas) / np.diff(time_s)
-    if profile == "two-speed":
-        # S-2 style: the middle third of the q range is only the ramp; cover each dwell instead
+    if len(level_q) == 2:
+        # S-2 style (two-speed, or step-pause with 2 levels): the middle third of the q range
+        # is only the ramp, whose length no duration changes; cover each dwell instead
         groups = tuple((run,) for run in _runs(np.isclose(qc, level_q[0]))[:1]
                        + _runs(np.isclose(qc, level_q[-1]))[-1:])
     else:

@@ -231,3 +231,17 @@ def test_settings_carry_the_request():
     assert s["profile"] == "step-pause" and s["levels"] == 4
     assert s["wind_from_deg"] == 270.0 and s["wind_speed_mps"] == 3.0
     assert s["radius_m"] == 926.0 and s["duration_s"] == 240.0
+
+
+def test_step_pause_with_two_levels_is_planned_like_two_speed():
+    """Two levels leave the middle third of q to the ramp alone, which no duration lengthens:
+    the search for a long-enough duration ran out of memory (killed). Cover each dwell."""
+    plan = plan_maneuver("step-pause", levels=2)
+    assert plan.success
+    two = make_schedule("two-speed", kt_to_mps(70), kt_to_mps(100), 240.0, altitude_m=244.0)
+    assert plan.settings["coverage_runs"] == [[list(r) for r in runs] for runs in two.groups]
+    for first, last in (runs[0] for runs in two.groups):
+        turned = abs(plan.heading_deg[last] - plan.heading_deg[first])
+        assert turned >= 360.0
+    with pytest.raises(PlanInfeasibleError, match=r"turn 360° in each dwell .* needs at least"):
+        plan_maneuver("step-pause", levels=2, duration_s=100)
