@@ -223,7 +223,8 @@ def check_autothrottle(plan, loop=None, *, turbulence_mps=0.0, turbulence_length
     if turbulence_mps > 0:
         from maneuvers.turbulence import dryden_gusts, dryden_scales
 
-        scales = dryden_scales(float(np.mean(plan.alt_m)), turbulence_mps, turbulence_length_m)
+        scales = dryden_scales(max(float(np.mean(plan.alt_m)), 0.0), turbulence_mps,
+                               turbulence_length_m)
         gust = dryden_gusts(t.size, 1.0 / rate_hz, scales, float(np.mean(tas_ref)),
                             np.random.default_rng(seed))[:, 0]
         gust_tf = control.tf([-1.0, 0.0], [1.0, x_u]) * sens

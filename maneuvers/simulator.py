@@ -202,7 +202,10 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     we_proc = we0 + drift[1] * (t - t_mid)
     tas_mean = float(np.mean(ref["tas_mps"]))
     if turbulence_mps > 0:
-        scales = dryden_scales(float(np.mean(ref["alt_m"])), turbulence_mps, turbulence_length_m)
+        # Dryden wants the height above ground; a test area below sea level (ISA altitude
+        # < 0, which the planner accepts) is taken as flown just above the ground.
+        scales = dryden_scales(max(float(np.mean(ref["alt_m"])), 0.0), turbulence_mps,
+                               turbulence_length_m)
         gust = dryden_gusts(n, dt, scales, tas_mean, rng_turb)
         ug, vg = gust[:, 0], gust[:, 1]
     else:

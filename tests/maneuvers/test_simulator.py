@@ -334,3 +334,14 @@ def test_cli_never_overwrites_the_plan_and_keeps_truth_beside(tmp_path, plan, ca
     assert main(["simulate", str(odd), "-o", str(tmp_path / "x.csv")]) == 2
     assert plan_path.read_bytes() == before == odd.read_bytes()
     assert not (tmp_path / "f.json").exists() and not (tmp_path / "x.csv").exists()
+
+
+def test_plan_below_sea_level_is_flown_in_turbulence():
+    """The planner accepts altitude_m down to -400 m (ISA); the Dryden scales refused it."""
+    from maneuvers.autothrottle import check_autothrottle
+
+    low = circle_plan(altitude_m=-100.0)
+    flight, truth = simulate(low, seed=1, turbulence_mps=0.5)
+    assert flight.n == 12001 and truth["tracking"]["max_cas_error_kt"] < 5.0
+    np.testing.assert_allclose(flight.rho_kgm3, isa_density_kgm3(-100.0), rtol=1e-6)
+    assert check_autothrottle(low, turbulence_mps=0.5).success
