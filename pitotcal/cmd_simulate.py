@@ -43,6 +43,7 @@ def add_parser(subparsers):
 
 def run(args):
     import logging
+    import warnings
     from pathlib import Path
 
     from estimation.errors import PitotcalError
@@ -91,6 +92,14 @@ def run(args):
                                      tr["max_cas_error_kt"], tr["max_radius_m"])
     print(f"wrote {args.output} ({flight.n} samples, {flight.time_s[-1] - flight.time_s[0]:.0f} s)"
           f" and {truth_path}")
+    radius = plan.settings.get("radius_m")
+    if tr["max_cas_error_kt"] > 5.0:
+        warnings.warn(f"the simulated auto-throttle left the ±5 KCAS band (max "
+                      f"{tr['max_cas_error_kt']:.1f} kt): the paper's criterion is not met in "
+                      f"this turbulence", stacklevel=2)
+    if isinstance(radius, (int, float)) and tr["max_radius_m"] > radius:
+        warnings.warn(f"the simulated track left the {radius:g} m test area (max "
+                      f"{tr['max_radius_m']:.0f} m)", stacklevel=2)
     coeffs = ", ".join(f"{name} {par[name]:g}" for name in model.params)
     print(f"truth: {model.name} {coeffs}; wind {par['wind_speed_mps']:.2f} m/s from "
           f"{par['wind_from_deg']:.1f} deg; tracking: CAS within {tr['max_cas_error_kt']:.1f} kt, "

@@ -345,3 +345,18 @@ def test_plan_below_sea_level_is_flown_in_turbulence():
     assert flight.n == 12001 and truth["tracking"]["max_cas_error_kt"] < 5.0
     np.testing.assert_allclose(flight.rho_kgm3, isa_density_kgm3(-100.0), rtol=1e-6)
     assert check_autothrottle(low, turbulence_mps=0.5).success
+
+
+def test_cli_warns_when_the_flight_leaves_the_paper_tolerances(tmp_path, plan, capsys):
+    from pitotcal.cli import main
+
+    plan_path = write_plan(plan, tmp_path / "plan.csv")
+    assert main(["simulate", str(plan_path), "-o", str(tmp_path / "calm.csv"),
+                 "--turbulence-mps", "0"]) == 0
+    assert "warning" not in capsys.readouterr().err
+    assert main(["simulate", str(plan_path), "-o", str(tmp_path / "rough.csv"),
+                 "--turbulence-mps", "2.5", "--seed", "1"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: the simulated auto-throttle left the ±5 KCAS band (max" in err
+    truth = json.loads((tmp_path / "rough.truth.json").read_text())
+    assert truth["tracking"]["max_cas_error_kt"] > 5.0
