@@ -89,9 +89,12 @@ def impact_pressure_sensor(qc_pa, dt_s, rng, *, model="inverse", k=(0.02, -15.0)
 
 
 def hold_index(time_s, rate_hz):
-    """Index of the latest sample at or before each update tick of a `rate_hz` device.
+    """For each sample, the index of the sample that carries the device's latest update.
 
-    With `rate_hz` None or 0, or not below the sample rate, every sample is its own update.
+    An update tick of a `rate_hz` device is recorded at the first sample at or after the tick
+    (never later than the sample itself, so the hold is causal); when the rates are not
+    multiples the update times jitter by up to one sample step. With `rate_hz` None or 0, or
+    not below the sample rate, every sample is its own update.
     """
     t = np.asarray(time_s, dtype=float)
     if not rate_hz:
