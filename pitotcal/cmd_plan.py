@@ -40,7 +40,10 @@ def add_parser(subparsers):
 
 
 def run(args):
+    import numpy as np
+
     from estimation.errors import PlanInfeasibleError
+    from maneuvers.autothrottle import check_autothrottle
     from maneuvers.outputs import write_plan_outputs
     from maneuvers.planner import plan_maneuver
 
@@ -55,7 +58,19 @@ def run(args):
     paths = write_plan_outputs(plan, args.output, figures=not args.no_figures)
     print(f"{args.profile} plan: {plan.time_s[-1]:.0f} s, {plan.n} nodes, "
           f"{plan.iterations} IPOPT iterations")
+    reach = float(np.max(np.hypot(plan.north_m, plan.east_m)))
+    print(f"  track within {reach:.0f} m of the centre (radius {args.radius_m:g} m), bank up "
+          f"to {np.max(np.abs(plan.bank_deg)):.0f}°, {args.cas_min_kt:g}-{args.cas_max_kt:g} "
+          f"KCAS")
     for kind, path in paths.items():
         print(f"  {kind:12s} {path}")
     sys.stdout.flush()
+    # issue 3 item 4: the auto-throttle's tracking against the paper's +-5 KCAS, reported
+    calm = check_autothrottle(plan)
+    rough = check_autothrottle(plan, turbulence_mps=0.5)
+    ok = calm.success and rough.success
+    print(f"auto-throttle check (PI, Kp {calm.loop.kp:.3g} 1/s, Ki {calm.loop.ki:.3g} 1/s², "
+          f"{calm.loop.phase_margin_deg:.0f}° phase margin): CAS error max "
+          f"{calm.max_error_kt:.1f} kt in still air, {rough.max_error_kt:.1f} kt in 0.5 m/s "
+          f"turbulence: {'within' if ok else 'OUTSIDE'} ±{calm.tolerance_kt:g} KCAS")
     return 0

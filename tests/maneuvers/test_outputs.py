@@ -158,3 +158,12 @@ def test_pilot_card_gives_where_to_start_and_bearings(plan):
     assert f"Start {start_ft:.0f} ft from centre on bearing {bearing:03.0f}°" in text
     first = next(line for line in text.splitlines() if line.startswith(" 0:00"))
     assert f"{start_ft:6.0f} ft {bearing:03.0f}°" in first
+
+
+def test_cli_plan_reports_track_and_autothrottle_check(tmp_path, capsys):
+    assert main(["plan", "--no-figures", "-o", str(tmp_path / "t2.csv")]) == 0
+    out = capsys.readouterr().out
+    plan = read_plan(tmp_path / "t2.csv")
+    reach = np.hypot(plan.north_m, plan.east_m).max()
+    assert f"track within {reach:.0f} m of the centre (radius 926 m)" in out
+    assert "auto-throttle check (PI, Kp" in out and "within ±5 KCAS" in out
