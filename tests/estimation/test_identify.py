@@ -202,3 +202,14 @@ def test_eiv_bias_below_half_sigma_at_1e6(n):
         corrected, uncorrected = _eiv_bias_at_1e6(n, seed)
         assert np.all(np.abs(corrected) < 0.5), (seed, corrected)
         assert abs(uncorrected[1]) > 0.5, (seed, uncorrected)   # the test can see the bias
+
+
+def test_5hz_gps_held_in_7hz_data_is_detected_and_interpolated():
+    """5 of every 7 samples carry a new fix (0.71): still sample-and-hold, and interpolated
+    (a threshold of 0.7 left it held, which biased k2 by ~3 sigma on simulated flights)."""
+    from estimation.eiv import gps_update_mask, interpolate_held
+
+    flight, _ = synthetic_flight(seed=3, n=2000, rate_hz=7.0, gps_rate_hz=5.0)
+    assert 0.69 < gps_update_mask(flight.gps_vn_mps, flight.gps_ve_mps).mean() < 0.73
+    (vn, _), factor = interpolate_held(flight.time_s, flight.gps_vn_mps, flight.gps_ve_mps)
+    assert factor < 1.0 and not np.array_equal(vn, flight.gps_vn_mps)
