@@ -33,6 +33,8 @@ __all__ = ["simulate", "write_truth_json", "truth_path_for", "GUIDANCE_GAINS", "
 # Memory grows with the samples (~1.5 kB each in the scalar loop, measured: 1.5 GB peak and
 # 13 s for 10^6): 500,000 is 2.8 h at 50 Hz, or 42 min at 200 Hz.
 MAX_SAMPLES = 500_000
+# The dynamics and autopilot never step slower than this (whole sub-steps per sample).
+DYNAMICS_RATE_HZ = 50.0
 
 GUIDANCE_GAINS = {"k_pos_per_s": 1.0 / 20.0, "k_psi_per_s": 0.4, "k_alt_per_s": 0.2}
 
@@ -183,14 +185,21 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     t0, t1 = float(plan.time_s[0]), float(plan.time_s[-1])
     n = int(math.floor((t1 - t0) * rate_hz + 1e-9)) + 1
     t = t0 + np.arange(n) * dt
-    ref = {name: np.interp(t, plan.time_s, plan.column(name))
+    # The aircraft and its autopilot fly at DYNAMICS_RATE_HZ or faster whatever the logging
+    # rate: the flight must not change with the data rate (at 7 Hz, stepping the dynamics at
+    # the logging rate put kinks in the velocity that biased k2 by ~-3 sigma, found in review).
+    sub = max(1, math.ceil(DYNAMICS_RATE_HZ / rate_hz - 1e-9))
+    dt_dyn = dt / sub
+    n_dyn = (n - 1) * sub + 1
+    t_dyn = t0 + np.arange(n_dyn) * dt_dyn
+    ref = {name: np.interp(t_dyn, plan.time_s, plan.column(name))
            for name in ("north_m", "east_m", "alt_m", "tas_mps", "bank_deg", "heading_deg")}
     # Ground-velocity and TAS-rate references from the plan's own grid (smoother than the
     # derivative of the interpolant), then interpolated.
-    vgn_ref = np.interp(t, plan.time_s, np.gradient(plan.north_m, plan.time_s))
-    vge_ref = np.interp(t, plan.time_s, np.gradient(plan.east_m, plan.time_s))
-    tas_dot_ref = np.interp(t, plan.time_s, np.gradient(plan.tas_mps, plan.time_s))
-    climb_ref = np.interp(t, plan.time_s, np.gradient(plan.alt_m, plan.time_s))
+    vgn_ref = np.interp(t_dyn, plan.time_s, np.gradient(plan.north_m, plan.time_s))
+    vge_ref = np.interp(t_dyn, plan.time_s, np.gradient(plan.east_m, plan.time_s))
+    tas_dot_ref = np.interp(t_dyn, plan.time_s, np.gradient(plan.tas_mps, plan.time_s))
+    climb_ref = np.interp(t_dyn, plan.time_s, np.gradient(plan.alt_m, plan.time_s))
     psi_dot_ff = G0_MPS2 * np.tan(np.radians(ref["bank_deg"])) / ref["tas_mps"]
 
     # -- wind: mean + drift about the middle + Dryden turbulence (path axes) -----------------
@@ -198,21 +207,21 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
                                  for s in np.random.SeedSequence(seed).spawn(3))
     wn0, we0 = _wind_vector(wind_speed_mps, wind_from_deg)
     t_mid = 0.5 * (t0 + t1)
-    wn_proc = wn0 + drift[0] * (t - t_mid)
-    we_proc = we0 + drift[1] * (t - t_mid)
+    wn_proc = wn0 + drift[0] * (t_dyn - t_mid)
+    we_proc = we0 + drift[1] * (t_dyn - t_mid)
     tas_mean = float(np.mean(ref["tas_mps"]))
     if turbulence_mps > 0:
         # Dryden wants the height above ground; a test area below sea level (ISA altitude
         # < 0, which the planner accepts) is taken as flown just above the ground.
         scales = dryden_scales(max(float(np.mean(ref["alt_m"])), 0.0), turbulence_mps,
                                turbulence_length_m)
-        gust = dryden_gusts(n, dt, scales, tas_mean, rng_turb)
+        gust = dryden_gusts(n_dyn, dt_dyn, scales, tas_mean, rng_turb)
         ug, vg = gust[:, 0], gust[:, 1]
     else:
-        ug = vg = np.zeros(n)
+        ug = vg = np.zeros(n_dyn)
     # An along-path gust changes the airspeed at once (the inertial speed cannot jump); the
     # drag and the auto-throttle then restore it. Hence -d(u_g)/dt in the speed equation.
-    dug = np.gradient(ug, dt) if n > 1 else np.zeros(n)
+    dug = np.gradient(ug, dt_dyn) if n_dyn > 1 else np.zeros(n_dyn)
 
     # -- controllers ---------------------------------------------------------------------------
     if speed_loop is None:
@@ -220,14 +229,14 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     kp, ki = speed_loop.kp, speed_loop.ki
     d_coef = G0_MPS2 / speed_loop.lift_to_drag / speed_loop.trim_tas_mps ** 2   # D = d_coef V^2
     thrust_max = d_coef * float(plan.tas_mps.max()) ** 2 + limits.accel_max_mps2
-    alpha_e = 1.0 - math.exp(-dt / speed_loop.engine_lag_s)
+    alpha_e = 1.0 - math.exp(-dt_dyn / speed_loop.engine_lag_s)
     # Thrust feed-forward D(V_ref) + V_ref', read one engine lag ahead: the schedule is known
     # in advance, and the engine delivers the command about tau_e later.
-    lead = int(round(speed_loop.engine_lag_s / dt))
-    ff_idx = np.minimum(np.arange(n) + lead, n - 1)
+    lead = int(round(speed_loop.engine_lag_s / dt_dyn))
+    ff_idx = np.minimum(np.arange(n_dyn) + lead, n_dyn - 1)
     ff_l = (d_coef * ref["tas_mps"][ff_idx] ** 2 + tas_dot_ref[ff_idx]).tolist()
     bank_max = math.radians(limits.bank_max_deg)
-    dbank_max = math.radians(limits.roll_rate_max_dps) * dt
+    dbank_max = math.radians(limits.roll_rate_max_dps) * dt_dyn
     k_pos, k_psi, k_alt = (GUIDANCE_GAINS[key] for key in ("k_pos_per_s", "k_psi_per_s",
                                                            "k_alt_per_s"))
     climb_max = limits.climb_max_mps
@@ -243,12 +252,12 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     bank = math.radians(float(ref["bank_deg"][0]))
     thrust = d_coef * x[4] ** 2 + tdot_r[0]
     integ = 0.0
-    j, last = 0, n - 1
+    j, last = 0, n_dyn - 1
     two_pi, pi = 2.0 * math.pi, math.pi
     cos, sin, atan, atan2 = math.cos, math.sin, math.atan, math.atan2
     drift_n, drift_e = drift
     rows, path_j = [], []
-    for i in range(n):
+    for i in range(n_dyn):
         north, east, alt, psi, v = x
         cpsi, spsi = cos(psi), sin(psi)
         wn = wnp_l[i] + cpsi * ug_l[i] - spsi * vg_l[i]      # v_g points to the right wing
@@ -284,13 +293,13 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
         if cmd > thrust_max:
             cmd = thrust_max
             if err < 0:
-                integ += err * dt
+                integ += err * dt_dyn
         elif cmd < 0.0:
             cmd = 0.0
             if err > 0:
-                integ += err * dt
+                integ += err * dt_dyn
         else:
-            integ += err * dt                               # anti-windup: only when unsaturated
+            integ += err * dt_dyn                           # anti-windup: only when unsaturated
         thrust += (cmd - thrust) * alpha_e
         accel = thrust - d_coef * v * v - dug_l[i] - cpsi * drift_n - spsi * drift_e
         climb = min(max(clr_l[i] + k_alt * (hr[i] - alt), -climb_max), climb_max)
@@ -300,10 +309,11 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
         # below a millimetre, and it halves the cost of RK4 (the loop's largest). The records
         # are the states themselves, so GPS and q_c stay exactly consistent either way.
         k1 = rhs(x, u, w, math)
-        k2 = rhs([a + dt * b for a, b in zip(x, k1)], u, w, math)
-        x = [a + 0.5 * dt * (b1 + b2) for a, b1, b2 in zip(x, k1, k2)]
+        k2 = rhs([a + dt_dyn * b for a, b in zip(x, k1)], u, w, math)
+        x = [a + 0.5 * dt_dyn * (b1 + b2) for a, b1, b2 in zip(x, k1, k2)]
     # columns: north, east, alt, psi, tas, bank, wind_n, wind_e (state at each sample time)
-    north, east, alt, psi, tas, bank_r, wn, we = np.array(rows).T
+    north, east, alt, psi, tas, bank_r, wn, we = np.array(rows[::sub]).T
+    path_j = path_j[::sub]                 # indices into the dynamics grid's references
 
     # -- true air data and sensors -------------------------------------------------------------
     rho = isa_density_kgm3(alt)
@@ -348,7 +358,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
                                                       east - ref["east_m"][path_j]))),
             "max_radius_m": float(np.max(radius)),
             "max_bank_deg": float(np.degrees(np.max(np.abs(bank_r)))),
-            "max_alt_error_m": float(np.max(np.abs(alt - ref["alt_m"]))),
+            "max_alt_error_m": float(np.max(np.abs(alt - ref["alt_m"][::sub]))),
         },
         "speed_loop": {"kp": kp, "ki": ki, "engine_lag_s": speed_loop.engine_lag_s,
                        "lift_to_drag": speed_loop.lift_to_drag,
@@ -360,7 +370,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
                             "heading_rad": psi, "tas_mps": tas, "cas_mps": cas,
                             "cas_ref_mps": cas_ref, "bank_rad": bank_r, "wind_n_mps": wn,
                             "wind_e_mps": we, "qc_pa": qc, "gps_true_mps": vel,
-                            "gust_mps": np.column_stack([ug, vg])}
+                            "gust_mps": np.column_stack([ug, vg])[::sub]}
     return flight, truth
 
 

@@ -360,3 +360,14 @@ def test_cli_warns_when_the_flight_leaves_the_paper_tolerances(tmp_path, plan, c
     assert "warning: the simulated auto-throttle left the ±5 KCAS band (max" in err
     truth = json.loads((tmp_path / "rough.truth.json").read_text())
     assert truth["tracking"]["max_cas_error_kt"] > 5.0
+
+
+def test_the_flight_does_not_depend_on_the_logging_rate(plan):
+    """The aircraft and autopilot step at >= 50 Hz whatever rate_hz is: a 10 Hz log samples the
+    same flight as a 50 Hz one (before, the dynamics stepped at the logging rate)."""
+    quiet = dict(seed=4, turbulence_mps=0.0, qc_noise_pa=0.0, gps_noise_mps=0.0, gps_rate_hz=0)
+    slow, _ = simulate(plan, rate_hz=10.0, **quiet)
+    fast, _ = simulate(plan, rate_hz=50.0, **quiet)
+    assert np.allclose(slow.time_s, fast.time_s[::5])
+    for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "alt_m"):
+        assert np.allclose(getattr(slow, name), getattr(fast, name)[::5], atol=1e-9), name
