@@ -21,7 +21,7 @@ from functools import lru_cache
 import numpy as np
 
 from estimation.errors import PitotcalError, PlanInfeasibleError
-from estimation.units import G0_MPS2, RHO0_KGM3, kt_to_mps, mps_to_kt
+from estimation.units import G0_MPS2, RHO0_KGM3, kt_to_mps, mps_to_kt, wind_vector_mps
 from maneuvers.dynamics import Limits, rhs
 from maneuvers.plan import Plan
 from maneuvers.profiles import PROFILES, make_schedule
@@ -38,12 +38,6 @@ MAX_NODES = 3000
 _KM = 1000.0          # position scale
 _PSI = 10.0           # heading scale (unwrapped heading reaches ~20 rad)
 _P = 0.1              # roll-rate scale, rad/s
-
-
-def wind_vector_mps(wind_speed_mps, wind_from_deg):
-    """Air-mass velocity (north, east), m/s: the way the wind blows TO (INTERFACES §2)."""
-    psi_w = np.radians(wind_from_deg)
-    return -wind_speed_mps * np.cos(psi_w), -wind_speed_mps * np.sin(psi_w)
 
 
 def turn_radius_m(tas_mps, bank_rad):

@@ -18,7 +18,8 @@ import numpy as np
 from estimation.errors import PitotcalError
 from estimation.flight import Flight
 from estimation.models import get_model
-from estimation.units import G0_MPS2, RHO0_KGM3, isa_density_kgm3, mps_to_kt
+from estimation.units import (G0_MPS2, RHO0_KGM3, isa_density_kgm3, mps_to_kt, wind_polar,
+                             wind_vector_mps)
 from maneuvers.autothrottle import tune_autothrottle
 from maneuvers.dynamics import Limits, rhs
 from maneuvers.plan import Plan
@@ -37,17 +38,6 @@ MAX_SAMPLES = 500_000
 DYNAMICS_RATE_HZ = 50.0
 
 GUIDANCE_GAINS = {"k_pos_per_s": 1.0 / 20.0, "k_psi_per_s": 0.4, "k_alt_per_s": 0.2}
-
-
-def _wind_vector(speed_mps, from_deg):
-    """(north, east) air-mass velocity of a wind blowing FROM `from_deg` (INTERFACES §2)."""
-    a = math.radians(from_deg)
-    return -speed_mps * math.cos(a), -speed_mps * math.sin(a)
-
-
-def _wind_polar(wn, we):
-    """(speed, from_deg in [0, 360)) of an air-mass velocity vector."""
-    return float(math.hypot(wn, we)), float(math.degrees(math.atan2(-we, -wn)) % 360.0)
 
 
 def _finite(name, value, lo=-math.inf, strict=False):
@@ -205,7 +195,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
     # -- wind: mean + drift about the middle + Dryden turbulence (path axes) -----------------
     rng_turb, rng_qc, rng_gps = (np.random.default_rng(s)
                                  for s in np.random.SeedSequence(seed).spawn(3))
-    wn0, we0 = _wind_vector(wind_speed_mps, wind_from_deg)
+    wn0, we0 = map(float, wind_vector_mps(wind_speed_mps, wind_from_deg))
     t_mid = 0.5 * (t0 + t1)
     wn_proc = wn0 + drift[0] * (t_dyn - t_mid)
     we_proc = we0 + drift[1] * (t_dyn - t_mid)
@@ -335,7 +325,7 @@ def simulate(plan, *, seed=0, model="inverse", k=(0.02, -15.0), wind_speed_mps=N
 
     # -- truth ------------------------------------------------------------------------------------
     mean_n, mean_e = float(np.mean(wn)), float(np.mean(we))
-    speed, from_deg = _wind_polar(mean_n, mean_e)
+    speed, from_deg = map(float, wind_polar(mean_n, mean_e))
     cas = tas * np.sqrt(rho / RHO0_KGM3)
     cas_ref = np.interp(t, plan.time_s, plan.cas_mps)
     radius = np.hypot(north, east)
