@@ -11,13 +11,12 @@ import inspect
 import json
 import logging
 import math
-import re
 import time
 from pathlib import Path
 
 from estimation.errors import PitotcalError
 
-from .runner import run_cases, run_one, write_table
+from .runner import count_errors, run_cases, run_one, write_table
 
 __all__ = ["STUDY_MODULES", "EXTERNAL_STUDIES", "study_names", "get_study", "run_study", "rerun"]
 
@@ -97,12 +96,7 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
     rows = run_cases(study.task, cases, base_seed=seed, workers=workers, scheduler=scheduler,
                      progress=progress)
     elapsed = time.perf_counter() - start
-    errors = {}
-    for row in rows:
-        if row.get("error"):
-            # numbers (seeds, degrees) masked so one cause is one entry; the table has the text
-            key = re.sub(r"\d+(\.\d+)?", "#", row["error"])
-            errors[key] = errors.get(key, 0) + 1
+    errors = count_errors(rows)
     summary = {"study": name, "description": study.description, "replicates": n_rep,
                "n_runs": len(cases), "n_rows": len(rows),
                "n_failed": sum(1 for r in rows if r.get("error")),

@@ -24,7 +24,6 @@ structurally biased at the ends of the speed range). Runs go through `studies.ru
 import csv
 import json
 import logging
-import re
 import time
 from pathlib import Path
 
@@ -277,7 +276,7 @@ def run_compare_peers(out_dir, runs=None, seed=0, *, times_s=None, model="consta
         wind; the first T reaching the targets; the claims in words), with ``inverse_truth``
         (the same for the inverse case), ``n_runs``, ``n_failed``, ``errors`` and ``files``.
     """
-    from .runner import run_cases
+    from .runner import count_errors, run_cases
 
     if runs is None:
         runs = QUICK_RUNS if quick else 10
@@ -300,11 +299,7 @@ def run_compare_peers(out_dir, runs=None, seed=0, *, times_s=None, model="consta
     rows = run_cases(peer_task, cases, base_seed=seed, workers=workers, scheduler=scheduler,
                      progress=progress)
     elapsed = time.perf_counter() - start
-    errors = {}
-    for row in rows:
-        if row.get("error"):
-            key = re.sub(r"\d+(\.\d+)?", "#", row["error"])
-            errors[key] = errors.get(key, 0) + 1
+    errors = count_errors(rows)
     summaries = []
     for m, kk in truths:
         good = [r for r in rows if r["truth_model"] == m and not r.get("error")]

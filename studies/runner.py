@@ -27,7 +27,7 @@ import traceback
 
 from estimation.errors import PitotcalError
 
-__all__ = ["SERIAL_BELOW", "run_cases", "run_one", "case_seed", "write_table", "read_table",
+__all__ = ["SERIAL_BELOW", "run_cases", "count_errors", "run_one", "case_seed", "write_table", "read_table",
            "echo_task"]
 
 log = logging.getLogger(__name__)
@@ -39,6 +39,19 @@ SERIAL_BELOW = 16
 def case_seed(base_seed, run_index, case):
     """Seed of run `run_index`: base_seed + the case's `seed_offset` (default: the run index)."""
     return int(base_seed) + int(case.get("seed_offset", run_index))
+
+
+def count_errors(rows):
+    """{error text with its numbers masked: count}: one entry per cause of failed runs (the
+    table keeps each run's full text)."""
+    import re
+
+    errors = {}
+    for row in rows:
+        if row.get("error"):
+            key = re.sub(r"\d+(\.\d+)?", "#", row["error"])
+            errors[key] = errors.get(key, 0) + 1
+    return errors
 
 
 def run_cases(task, cases, *, base_seed=0, workers=None, scheduler=None, progress=None):
