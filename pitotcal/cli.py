@@ -8,6 +8,7 @@ stderr and the error's exit status (INTERFACES §3): never a traceback for bad i
 import argparse
 import importlib
 import logging
+import os
 import sys
 import warnings
 
@@ -49,6 +50,11 @@ def main(argv=None):
 
     try:
         return int(args.run(args) or 0)
+    except BrokenPipeError:
+        # the reader of our output (`| head`) went away: not an error of ours; silence the
+        # interpreter's own complaint when it flushes stdout at exit
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except PitotcalError as exc:
         print(f"pitotcal {args.command}: {exc}", file=sys.stderr)
         return exc.exit_status
