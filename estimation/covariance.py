@@ -51,6 +51,7 @@ class ColoredCovariance:
     window: str
     ar1: float               # exponential: decay per sample; windows: lag-1 autocorrelation
     warning: str | None = None
+    dof: float = float("inf")  # degrees of freedom of the noise-model fit (Student-t widening)
 
     def describe(self):
         return f"{self.window} R_vv, {self.lag} lags (decay/AR(1) {self.ar1:.4f} per sample)"
@@ -98,7 +99,8 @@ def lag_weights(lag, window="bartlett"):
     return np.where(x <= 0.5, 1 - 6 * x ** 2 + 6 * x ** 3, 2 * (1 - x) ** 3)
 
 
-def colored_covariance(jac, residuals, *, window="exponential", lag=None, information=None):
+def colored_covariance(jac, residuals, *, window="exponential", lag=None, information=None,
+                       instruments=None):
     """Covariance corrected for colored residuals (Morelli & Klein 1997; SIDPAC `colores`).
 
     Parameters
@@ -142,18 +144,29 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None, inform
     """
     n, p = jac.shape
     a = 0.0
+    dof = float("inf")
     if window == "exponential":
-        h, lag, a = _exponential_acov(residuals, jac)
+        h, lag, a, dof = _exponential_acov(residuals, jac)
     else:
         if lag is None:
             lag, a = truncation_lag(residuals, window)
         lag = int(min(lag, n - 1))
         acov = residual_acf(residuals, lag) * n / max(n - p, 1)
         h = lag_weights(lag, window) * acov
-    hs = _toeplitz_times(h, jac)
-    m_inv = _inv_sym(jac.T @ jac if information is None else information)
-    middle = jac.T @ hs
-    cov = m_inv @ (0.5 * (middle + middle.T)) @ m_inv
+    if instruments is None:
+        hs = _toeplitz_times(h, jac)
+        m_inv = _inv_sym(jac.T @ jac if information is None else information)
+        middle = jac.T @ hs
+        cov = m_inv @ (0.5 * (middle + middle.T)) @ m_inv
+    else:
+        # instrumental variables: A^-1 Z^T R_vv Z A^-T, A = Z^T S
+        a_inv = np.linalg.inv(instruments.T @ jac if information is None else information)
+        middle = instruments.T @ _toeplitz_times(h, instruments)
+        cov = a_inv @ (0.5 * (middle + middle.T)) @ a_inv.T
+    # The noise model is fitted to one record: with T / tau correlation times in it, the long-run
+    # variance has ~T / (4 tau) degrees of freedom (an OU process: S(0) = D tau^2, tau known to
+    # CV^2 = 2 tau / T). Widen so that +-2 sigma holds 95.45% under Student t with those dof.
+    cov = cov * student_t_widening(dof) ** 2
     # correlation time, samples: of the fitted decay, or half the window
     tau = -1.0 / np.log(a) if window == "exponential" and 0.0 < a < 1.0 else lag / 2.0
     stretches = n / max(2.0 * tau, 1.0)
@@ -162,7 +175,18 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None, inform
         warning = (f"residuals correlated over ~{2 * tau:.0f} samples: only ~{stretches:.0f} "
                    "independent stretches of data, so the corrected bounds are themselves "
                    f"uncertain by ~{100 / np.sqrt(max(stretches, 1.0)):.0f}%; fly longer")
-    return ColoredCovariance(cov, lag, window, a, warning)
+    return ColoredCovariance(cov, lag, window, a, warning, dof)
+
+
+def student_t_widening(dof, z=2.0):
+    """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
+    dof >= 3, without importing scipy.stats); 1 for infinite dof."""
+    if not np.isfinite(dof):
+        return 1.0
+    v = max(float(dof), 3.0)
+    t = (z + (z ** 3 + z) / (4 * v) + (5 * z ** 5 + 16 * z ** 3 + 3 * z) / (96 * v ** 2)
+         + (3 * z ** 7 + 19 * z ** 5 + 17 * z ** 3 - 15 * z) / (384 * v ** 3))
+    return t / z
 
 
 def to_reported(n_coef, theta, cov):
@@ -206,20 +230,40 @@ def _exponential_acov(residuals, jac):
     acov = residual_acf(residuals, kmax) * n / max(n - p, 1)
     # lag-1 correlation within sampling noise of zero (~1/sqrt(N)): white residuals
     if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
-        return acov[:1], 0, float(acov[1] / acov[0])
+        return acov[:1], 0, float(acov[1] / acov[0]), float("inf")
     below = np.nonzero(acov[1:] < acov[1] / np.e)[0]
     ke = int(below[0]) + 1 if below.size else kmax      # 1/e lag of the sample ACF
     step = int(np.ceil(n / FIT_SAMPLES))
+    dof = float("inf")
     if ke >= MIN_FIT_TAU * step:
-        white, amp, tau = _fit_projected(jac[::step], residuals[::step], ke / step)
-        tau *= step          # (the projection already accounts for the fitted dof)
+        tau = _decay_from_increments(residuals, ke)
+        white, amp, _ = _fit_projected(jac[::step], residuals[::step], ke / step, tau=tau / step)
+        dof = n / (4.0 * tau)
     else:
         white, amp, tau = _fit_direct(acov, ke)
     a = float(np.exp(-1.0 / max(tau, 1e-3)))
     lag = int(min(np.ceil(tau * np.log(1e4)), n - 1))
     h = amp * a ** np.arange(lag + 1)
     h[0] += white
-    return h, lag, a
+    return h, lag, a, dof
+
+
+def _decay_from_increments(residuals, ke):
+    """Decay time (samples) of white + exponential noise from the residuals' increments.
+
+    gamma(k) = white + amp (1 - a^k) for k >= 1, so gamma(2s) - gamma(s) ~ amp s / tau for
+    s << tau (the white part cancels) and tau ~ s var / (gamma(2s) - gamma(s)). Every increment
+    counts, so the decay is known to CV ~ sqrt(2 tau / T) (0.23 measured on the T-2 flight)
+    where a fit to the autocovariance's shape leans on its noisy long lags (CV 0.8 measured,
+    the main cause of the k1/k2 bounds' run-to-run scatter and their 89% coverage).
+    """
+    n = residuals.size
+    s = max(int(round(ke / 12)), 2)
+    v = residuals - residuals.mean()
+    g1 = 0.5 * np.mean((v[s:] - v[:-s]) ** 2)
+    g2 = 0.5 * np.mean((v[2 * s:] - v[:-2 * s]) ** 2)
+    tau = s * float(np.mean(v * v)) / max(g2 - g1, 1e-300)
+    return float(np.clip(tau, 2.0 * s, n / 4.0))
 
 
 # The noise model of long correlation times is fitted on every step-th sample, at most this
@@ -242,7 +286,7 @@ def _fit_direct(acov, ke):
     return max(acov[0] - amp, 0.0), amp, tau
 
 
-def _fit_projected(s, r, ke):
+def _fit_projected(s, r, ke, tau=None):
     """Fit (white, amp, tau) so that E[acov((I - P) e)] matches the residuals' acov.
 
     With e of autocovariance R (Toeplitz Sigma) and X = (I - P) Sigma (I - P),
@@ -253,7 +297,7 @@ def _fit_projected(s, r, ke):
     """
     m, p = s.shape
     minv = _inv_sym(s.T @ s)
-    kfit = int(min(np.ceil(FIT_LAGS * ke), m // 4))
+    kfit = int(min(np.ceil(FIT_LAGS * (ke if tau is None else tau)), m // 4))
     obs = residual_acf(r, kfit)
     size = _fast_len(2 * m)
     fs = np.fft.rfft(s, size, axis=0)
@@ -281,6 +325,9 @@ def _fit_projected(s, r, ke):
         coef, sse = _nnls2(b_white, b_exp, obs)
         return sse, coef
 
+    if tau is not None:                          # decay given: amplitudes only
+        _, (white, amp) = fit(tau)
+        return white, amp, tau
     taus = np.geomspace(max(ke / 4, 0.3), 12 * ke, 12)
     i = int(np.argmin([fit(t)[0] for t in taus]))
     lo, hi = np.log(taus[max(i - 1, 0)]), np.log(taus[min(i + 1, taus.size - 1)])

@@ -162,13 +162,15 @@ def test_eiv_estimate_and_correction_direction():
     corrected = identify(flight, "constant")
     assert corrected.gps_noise_std_mps == pytest.approx(0.3, rel=0.1)
     raw = identify(flight, "constant", gps_noise_std_mps=0.0)
-    # uncorrected, noise inflates the predicted q_c: k1 biased up by ~3 rho sigma^2 / q_c
+    # uncorrected, noise inflates the predicted q_c by rho sigma^2 (two components): k1 biased
+    # up by ~rho sigma^2 / q_c. (The output-error fit alone had ~3x that, the extra from noise
+    # in its sensitivities; the instrumental-variable rows are free of it.)
     shift = raw.value("k1") - corrected.value("k1")
-    expected = 3 * 1.196 * 0.09 / np.mean(flight.qci_pa)
+    expected = 1.196 * 0.09 / np.mean(flight.qci_pa)
     assert shift == pytest.approx(expected, rel=0.35)
 
 
-def _eiv_bias_at_1e6(n, seed, sigma_v=0.3):
+def _eiv_bias_at_1e6(n, seed, sigma_v=0.6):
     """EIV bias of (k1, k2) in units of their sigma at N = 1e6: corrected and uncorrected.
 
     Antithetic pairs: the same held GPS noise added with + and - sign. The bias is even in
@@ -196,8 +198,9 @@ def _eiv_bias_at_1e6(n, seed, sigma_v=0.3):
     pytest.param(1_000_000, marks=pytest.mark.slow),
 ])
 def test_eiv_bias_below_half_sigma_at_1e6(n):
-    """GPS noise 0.3 m/s at 5 Hz held: uncorrected, k2 is biased by ~0.9 sigma of an N = 1e6
-    flight (measured); corrected, both coefficients stay below 0.5 sigma."""
+    """GPS noise 0.6 m/s at 5 Hz held: uncorrected, k2 is biased by ~1.2 sigma of an N = 1e6
+    flight (measured: 0.31 at 0.3 m/s, 0.53 at 0.5, growing as sigma_v^2); corrected, both
+    coefficients stay below 0.5 sigma (measured <= 0.02)."""
     for seed in range(2):
         corrected, uncorrected = _eiv_bias_at_1e6(n, seed)
         assert np.all(np.abs(corrected) < 0.5), (seed, corrected)
