@@ -238,7 +238,7 @@ def _exponential_acov(residuals, jac):
     if ke >= MIN_FIT_TAU * step:
         tau = _decay_from_increments(residuals, ke)
         white, amp, _ = _fit_projected(jac[::step], residuals[::step], ke / step, tau=tau / step)
-        dof = n / (4.0 * tau)
+        dof = n / (DOF_TAUS * tau)
     else:
         white, amp, tau = _fit_direct(acov, ke)
     a = float(np.exp(-1.0 / max(tau, 1e-3)))
@@ -270,6 +270,8 @@ def _decay_from_increments(residuals, ke):
 # many samples: the decay spans hundreds of samples, so thinning loses nothing and the fit
 # costs the same at N = 1e6 as at 16,000.
 FIT_SAMPLES = 4000
+# Degrees of freedom of the fitted noise model: one per DOF_TAUS correlation times.
+DOF_TAUS = 4.0
 # Thinned, the 1/e lag must still span this many samples to be resolved.
 MIN_FIT_TAU = 4
 # The fit uses lags up to this many 1/e lags.
