@@ -9,7 +9,10 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["PressureErrorModel", "MODELS", "get_model", "qci_from_qc_pa", "qc_from_qci_pa"]
+from .units import cas_from_qc_mps, kt_to_mps, mps_to_kt, qc_from_cas_pa
+
+__all__ = ["PressureErrorModel", "MODELS", "get_model", "qci_from_qc_pa", "qc_from_qci_pa",
+           "delta_v_kt"]
 
 
 @dataclass(frozen=True)
@@ -83,3 +86,11 @@ def qci_from_qc_pa(model, k, qc_pa, iterations=50):
             return new
         qci = new
     return qci
+
+
+def delta_v_kt(model, k, vi_kt):
+    """Airspeed correction ΔV = V_c - V_i, kt, at indicated airspeed `vi_kt` (INTERFACES §2):
+    q_ci = rho0 V_i^2 / 2, q_c = q_ci / (1 - f(q_ci)), V_c = sqrt(2 q_c / rho0)."""
+    vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
+    qc = qc_from_qci_pa(model, k, qc_from_cas_pa(vi_mps))
+    return mps_to_kt(cas_from_qc_mps(qc) - vi_mps)

@@ -4,8 +4,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .models import get_model
-from .units import RHO0_KGM3, mps_to_kt, kt_to_mps
+from .models import delta_v_kt, get_model
 
 __all__ = ["IdentificationResult"]
 
@@ -122,15 +121,8 @@ class IdentificationResult:
         """
         model = get_model(self.model)
         k = self.coefficients
-        vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
-        qci = 0.5 * RHO0_KGM3 * vi_mps ** 2
-
-        def dv_kt(kk):
-            qc = qci / (1.0 - model(kk, qci))
-            return mps_to_kt(np.sqrt(2.0 * qc / RHO0_KGM3) - vi_mps)
-
-        grad = _gradient(dv_kt, k)
-        return dv_kt(k), 2.0 * _band(grad, self._coef_cov(plain))
+        grad = _gradient(lambda kk: delta_v_kt(model, kk, vi_kt), k)
+        return delta_v_kt(model, k, vi_kt), 2.0 * _band(grad, self._coef_cov(plain))
 
     # --- presentation (estimation/report.py) --------------------------------------------
     def summary(self):

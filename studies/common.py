@@ -13,8 +13,8 @@ from typing import Callable
 
 import numpy as np
 
-from estimation.models import get_model, qc_from_qci_pa
-from estimation.units import RHO0_KGM3, kt_to_mps, mps_to_kt, wind_polar
+from estimation.models import delta_v_kt, get_model
+from estimation.units import cas_from_qc_mps, mps_to_kt, wind_polar
 
 __all__ = ["T2_PLAN", "get_plan", "fly", "identify_flight", "score", "true_delta_v_kt",
            "wrap_deg", "first_seconds", "truth_for", "run_fly_identify", "Study", "ok_rows", "column",
@@ -96,11 +96,7 @@ def wrap_deg(angle_deg):
 
 def true_delta_v_kt(model, k, vi_kt):
     """Truth ΔV = V_c - V_i (kt) at indicated `vi_kt` for pressure-error `model` with coefficients `k`."""
-    m = get_model(model)
-    vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
-    qci = 0.5 * RHO0_KGM3 * vi_mps ** 2
-    qc = qc_from_qci_pa(m, k, qci)
-    return mps_to_kt(np.sqrt(2.0 * qc / RHO0_KGM3) - vi_mps)
+    return delta_v_kt(get_model(model), k, vi_kt)
 
 
 def score(result, truth, flight=None):
@@ -128,7 +124,7 @@ def score(result, truth, flight=None):
                     f"{name}_z": err / std if std > 0 else float("nan"),
                     f"{name}_z_plain": err / std_plain if std_plain > 0 else float("nan")})
     qci = result.qci_pa if flight is None else flight.qci_pa
-    vi_kt = mps_to_kt(np.sqrt(2.0 * np.maximum(qci, 0.0) / RHO0_KGM3))
+    vi_kt = mps_to_kt(cas_from_qc_mps(np.maximum(qci, 0.0)))
     lo, hi = np.percentile(vi_kt, [2.0, 98.0])
     grid = np.linspace(lo, hi, N_DV_GRID)
     dv, dv_2s = result.delta_v_kt(grid)

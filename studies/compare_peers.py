@@ -66,8 +66,8 @@ def _true_dv_grid_kt(truth, vi_kt):
 
 def _vi_grid_kt(flight):
     """N_DV_GRID indicated airspeeds spanning the 2-98 % range flown in `flight`, kt."""
-    from estimation.units import RHO0_KGM3, mps_to_kt
-    vi = mps_to_kt(np.sqrt(2.0 * np.maximum(flight.qci_pa, 0.0) / RHO0_KGM3))
+    from estimation.units import cas_from_qc_mps, mps_to_kt
+    vi = mps_to_kt(cas_from_qc_mps(np.maximum(flight.qci_pa, 0.0)))
     lo, hi = np.percentile(vi, [2.0, 98.0])
     return np.linspace(lo, hi, N_DV_GRID)
 

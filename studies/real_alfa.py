@@ -34,7 +34,8 @@ import numpy as np
 
 from estimation.errors import FlightDataError, PitotcalError
 from estimation.flight import Flight
-from estimation.units import RHO0_KGM3, R_AIR_JKGK, isa_temperature_k, mps_to_kt, wind_polar
+from estimation.units import (RHO0_KGM3, R_AIR_JKGK, cas_from_qc_mps, isa_temperature_k, mps_to_kt,
+                             wind_polar)
 
 from .baselines import (ardupilot_autocal, ardupilot_ratio_from_k1, k1_from_ardupilot_ratio,
                         px4_wind_estimator)
@@ -272,7 +273,7 @@ def run_real_alfa(out_dir, *, data_dir=None, oat="autopilot", plot=True):
     flight = read_alfa_flight(d, oat=oat)
     t0 = float(flight.meta["t0_unix_s"])
     seg = (float(flight.time_s[0]), float(flight.time_s[-1]))
-    vi_kt = mps_to_kt(np.sqrt(2.0 * flight.qci_pa / RHO0_KGM3))
+    vi_kt = mps_to_kt(cas_from_qc_mps(flight.qci_pa))
     vi_ref_kt = float(np.median(vi_kt))
 
     ours = {}
