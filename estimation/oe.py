@@ -200,13 +200,12 @@ class OutputErrorProblem:
         info = _information(built.hessian, x_opt, p_val, scales, n, scalars[3], jac)
         # instrumental-variable refinement of the coefficients (see _iv_refine)
         q_smooth = smooth_in_time(flight.qci_pa, flight.time_s, IV_WINDOW_S)
-        theta_iv, instruments = _iv_refine(m, theta, flight.qci_pa, vn, ve, flight.rho_kgm3, vd2,
-                                           c_eiv, var_v, q_smooth)
+        theta_iv, instruments, jac_iv = _iv_refine(m, theta, flight.qci_pa, vn, ve,
+                                                   flight.rho_kgm3, vd2, c_eiv, var_v, q_smooth)
         if instruments is None:
             warn.append("instrumental-variable refinement did not converge; output-error estimate kept")
         else:
-            theta = theta_iv
-            jac = _sensitivities_np(m, theta, flight.qci_pa, vn, ve, flight.rho_kgm3, vd2, c_eiv)
+            theta, jac = theta_iv, jac_iv
         residuals = _residual_np(m, theta, flight.qci_pa, vn, ve, flight.rho_kgm3, vd2, c_eiv)
         cov_plain = plain_covariance(jac, residuals, information=info)
         if instruments is None:
@@ -288,7 +287,7 @@ def _instruments(model, theta, q_smooth, jac):
 def _iv_refine(model, theta, qci, vn, ve, rho, vd2, c_eiv, var_v, q_smooth, max_iter=10):
     """Solve Z^T r(theta) = corrected-score terms by Newton steps from the output-error optimum.
 
-    Returns (theta, Z) or (theta_in, None) when the iteration does not converge.
+    Returns (theta, Z, S) at the solution, or (theta_in, None, None) when it does not converge.
     """
     nk = len(model.params)
     scales = np.array(list(model.scales) + [1.0, 1.0])
@@ -304,14 +303,14 @@ def _iv_refine(model, theta, qci, vn, ve, rho, vd2, c_eiv, var_v, q_smooth, max_
         try:
             step = np.linalg.solve(z.T @ s, g)
         except np.linalg.LinAlgError:
-            return theta, None
+            return theta, None, None
         if not np.all(np.isfinite(step)):
-            return theta, None
+            return theta, None, None
         th = th - step
         if np.max(np.abs(step / scales)) < 1e-6:       # as IPOPT tol: far below any sigma
             s = _sensitivities_np(model, th, qci, vn, ve, rho, vd2, c_eiv)
-            return th, _instruments(model, th, q_smooth, s)
-    return theta, None
+            return th, _instruments(model, th, q_smooth, s), s
+    return theta, None, None
 
 
 def _residual_np(model, theta, qci, vn, ve, rho, vd2, c_eiv):
