@@ -34,7 +34,7 @@ import numpy as np
 
 from estimation.errors import FlightDataError, PitotcalError
 from estimation.flight import Flight
-from estimation.units import (RHO0_KGM3, R_AIR_JKGK, cas_from_qc_mps, isa_temperature_k, mps_to_kt,
+from estimation.units import (RHO0_KGM3, cas_from_qc_mps, density_kgm3, isa_temperature_k, mps_to_kt,
                              wind_polar)
 
 from .baselines import (ardupilot_autocal, ardupilot_ratio_from_k1, k1_from_ardupilot_ratio,
@@ -191,7 +191,7 @@ def read_alfa_flight(data_dir=None, *, oat="autopilot", powered_only=True, margi
         else:
             temp = np.full(t_unix.size, oat)
             meta["density"] = f"ps / (R * {oat:g} K)"
-        rho = ps / (R_AIR_JKGK * temp)
+        rho = density_kgm3(ps, temp)
     if cal is not None and "ratio" in cal:
         meta["autopilot_ratio"] = f"{float(np.median(cal['ratio'])):.5g}"
 
