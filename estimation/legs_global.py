@@ -37,19 +37,23 @@ BAND_FT = 1000.0          # width of an altitude band for `per-band` winds
 
 
 def wind_groups(legs, mode, band_ft=BAND_FT):
-    """(group index of each leg, group labels): per point, or per pressure-altitude band
-    (the points' mean altitude rounded to `band_ft`)."""
-    labels, group = [], np.empty(legs.n, dtype=int)
-    for p in legs.points():
-        idx = legs.indices(p)
-        if mode == "per-point":
-            key = f"point {p}"
-        else:
-            alt_ft = float(np.mean(legs.pressure_alt_m[idx])) / 0.3048
-            key = f"{band_ft * round(alt_ft / band_ft):.0f} ft"
-        if key not in labels:
-            labels.append(key)
-        group[idx] = labels.index(key)
+    """(group index of each leg, group labels): per point, or per pressure-altitude band of
+    `band_ft` counted up from the lowest point (each point by its legs' mean altitude), labelled
+    by the band's mean altitude."""
+    points = legs.points()
+    alt_ft = np.array([np.mean(legs.pressure_alt_m[legs.indices(p)]) for p in points]) / 0.3048
+    if mode == "per-point":
+        keys = list(range(len(points)))
+    else:
+        keys = [int(np.floor((a - alt_ft.min()) / band_ft + 1e-9)) for a in alt_ft]
+    order = list(dict.fromkeys(keys))
+    group = np.empty(legs.n, dtype=int)
+    for p, key in zip(points, keys):
+        group[legs.indices(p)] = order.index(key)
+    if mode == "per-point":
+        return group, [f"point {p}" for p in points]
+    labels = [f"{np.mean([a for a, k in zip(alt_ft, keys) if k == key]):.0f} ft"
+              for key in order]
     return group, labels
 
 
@@ -217,12 +221,20 @@ def fit_legs(legs, model="inverse", wind="per-band", initial_winds=None):
 def _check_counts(legs, nk, ng, wind, stated):
     m, p = legs.n, nk + 2 * ng
     need = p + (0 if stated else 1)
+    n_speeds = len({round(float(v), 1) for v in legs.ias_kt})
+    if n_speeds < nk:
+        raise ObservabilityError(
+            f"{legs.source}: {n_speeds} indicated airspeed{'s' * (n_speeds != 1)} cannot "
+            f"determine the {nk} coefficients of the model: fly points at {nk} or more speeds, "
+            f"or choose a model with fewer coefficients")
     if m < need:
         per = "per point" if wind == "per-point" else "per altitude band"
+        hint = "one wind per altitude band (--wind per-band), " if wind == "per-point" else ""
         raise ObservabilityError(
-            f"{legs.source}: {m} legs cannot determine {nk} model coefficients and {ng} winds "
-            f"({per}): {need} legs needed{'' if stated else ' (one more to estimate the noise)'}"
-            f"; add points or legs, use --wind per-band, or a model with fewer coefficients")
+            f"{legs.source}: {m} legs cannot determine {nk} model coefficients and {ng} "
+            f"wind{'s' * (ng != 1)} ({per}): {need} legs needed"
+            f"{'' if stated else ' (one more to estimate the noise)'}; add points or legs, "
+            f"{hint}or state groundspeed_sd_kt")
 
 
 def _result(legs, pe, wind, labels, sol, scales, sigma, stated):

