@@ -110,9 +110,10 @@ def _global_text(fit):
     for w in d["winds"]:
         out.append(f"  wind {w['group']}: {w['wind_speed_kt']:.1f} kt from "
                    f"{w['wind_from_deg']:.0f}° (±{w['wind_2sigma_kt']:.1f} kt)")
-    out += ["", "Airspeed correction, ΔV = V_c − V_ic (add ΔV to the indicated airspeed):",
-            f"  {'KIAS':>7}{'ΔV kt':>9}{'±2σ kt':>9}{'KCAS':>8}"]
-    out += [f"  {r['vi_kt']:7.1f}{r['dv_kt']:+9.2f}{r['dv_2sigma_kt']:9.2f}{r['vc_kt']:8.1f}"
+    out += ["", ("Airspeed correction, ΔV = V_c − V_ic (add ΔV to the indicated airspeed; ±: 95 % "
+                "half-width, 2σ with a stated accuracy):"),
+            f"  {'KIAS':>7}{'ΔV kt':>9}{'±95% kt':>10}{'KCAS':>8}"]
+    out += [f"  {r['vi_kt']:7.1f}{r['dv_kt']:+9.2f}{r['dv_2sigma_kt']:10.2f}{r['vc_kt']:8.1f}"
             for r in d["airspeed_correction"]]
     return "\n".join(out)
 
