@@ -22,7 +22,7 @@ cell is a typo to fix. The file is opened read-only.
 """
 
 import csv
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -90,7 +90,6 @@ class LegData:
     groundspeed_sd_mps: np.ndarray
     source: str = ""
     lines: tuple = ()
-    warnings: tuple = field(default_factory=tuple)
 
     @property
     def n(self):
