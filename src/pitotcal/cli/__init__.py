@@ -17,7 +17,8 @@ import warnings
 
 from pitotcal import __version__
 
-COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study")
+COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study",
+            "report")  # issue 10: the calibration report
 
 
 def build_parser():
