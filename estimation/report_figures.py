@@ -101,11 +101,12 @@ def track_png(flight, ident):
     wind = ident.value("wind_speed_mps"), np.radians(ident.value("wind_from_deg"))
     span = max(np.ptp(east), np.ptp(north), 1.0)
     x0, y0 = east.min(), north.max()
-    # the arrow points where the wind blows TO
+    # the red arrow points where the wind blows TO
     ax_t.annotate("", xy=(x0 - 0.15 * span * np.sin(wind[1]), y0 - 0.15 * span * np.cos(wind[1])),
                   xytext=(x0, y0), arrowprops={"arrowstyle": "->", "color": "tab:red", "lw": 2})
     ax_t.set(xlabel="east (m)", ylabel="north (m)", aspect="equal",
-             title=f"Ground track from GPS velocity; wind {wind[0]:.1f} m/s (red: blows to)")
+             title=f"Ground track from GPS velocity\nwind {wind[0]:.1f} m/s from "
+                   f"{ident.value('wind_from_deg'):.0f}° (red arrow: blows to)")
     r = np.asarray(ident.residuals_pa, dtype=float)
     ax_h.hist(r[np.isfinite(r)], bins=60, density=True, color="tab:purple", alpha=0.7)
     s = max(float(np.nanstd(r)), 1e-9)
