@@ -322,10 +322,13 @@ def read_result(path):
     return doc
 
 
-def make_report(result_path, html_path, *, flight_path=None, aircraft_path=None,
+def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
+                aircraft_path=None,
                 regulation="23.1323", speed_range_kt=None, json_path=None, pdf_path=None,
                 options=None):
     """Read the inputs, write the HTML report (and the JSON / PDF when asked).
+
+    `flight_options` go to `read_flight` (start_s, end_s, oat_k: the reading identify used).
 
     Returns
     -------
@@ -340,7 +343,9 @@ def make_report(result_path, html_path, *, flight_path=None, aircraft_path=None,
 
         from .identification import identify
 
-        flight = read_flight(flight_path)
+        opts = {k: v for k, v in (flight_options or {}).items() if v is not None}
+        flight = read_flight(flight_path, opts.pop("start_s", None), opts.pop("end_s", None),
+                             **opts)
         ident = identify(flight, model=result.get("model", "inverse"),
                          gps_noise_std_mps=result.get("gps_noise_std_mps"))
         inputs.append(("Flight", flight_path))

@@ -34,3 +34,31 @@ def test_params_on_top_of_input_refused_before_work(flight, tmp_path, capsys):
     write_flight_csv(flight, path)
     assert main(["identify", str(path), "--params", str(path)]) == 2
     assert "--params" in capsys.readouterr().err
+
+
+def test_px4_ulog_end_to_end_qgc_file(flight, tmp_path, capsys):
+    """A ULog with the older ASPD_SCALE = 1: the QGC file carries that name and 1/sqrt(1-k1)."""
+    from logwriters import write_ulog
+
+    from pitotcal.io.param_files import read_qgc_params
+
+    log, out = tmp_path / "f.ulg", tmp_path / "new.params"
+    write_ulog(log, flight)
+    assert main(["identify", str(log), "--model", "constant", "--params", str(out)]) == 0
+    params = read_qgc_params(out)
+    assert list(params) == ["ASPD_SCALE"]
+    assert params["ASPD_SCALE"] == pytest.approx(1.0 / 0.82 ** 0.5, rel=2e-3)
+    assert "current value 1;" in out.read_text()
+
+
+def test_dataflash_end_to_end_mavproxy_file(flight, tmp_path, capsys):
+    from logwriters import write_dataflash_text
+    from pymavlink.mavparm import MAVParmDict
+
+    log, out = tmp_path / "f.log", tmp_path / "new.param"
+    write_dataflash_text(log, flight, ratio=2.0)
+    assert main(["identify", str(log), "--model", "constant", "--params", str(out)]) == 0
+    loaded = MAVParmDict()
+    loaded.load(str(out))
+    assert loaded["ARSPD_RATIO"] == pytest.approx(2.0 / (1.225 * 0.82), rel=4e-3)
+    assert "current value 2;" in out.read_text()

@@ -36,6 +36,15 @@ def test_report_with_flight_has_four_figures_and_provenance(identified, tmp_path
     assert block["speed_range_kt"] == [72.0, 95.0] and block["verdict"] == "complies"
 
 
+def test_flight_window_is_the_reading_identify_used(identified, tmp_path):
+    """A report re-read with another window does not reproduce the result, and says so."""
+    csv, result = identified
+    html = tmp_path / "r.html"
+    assert main(["report", str(result), "--flight", str(csv), "--end-s", "40",
+                 "-o", str(html)]) == 0
+    assert "the flight given does not reproduce the result" in html.read_text()
+
+
 @pytest.mark.parametrize("args, match", [
     (["--regulation", "CS-VLA"], "--regulation 'CS-VLA' is not one of 23.1323, 25.1323, none"),
     (["--speed-range-kt", "90", "80"], "--speed-range-kt 90 80: the highest speed must be"),

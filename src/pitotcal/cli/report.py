@@ -23,6 +23,12 @@ def add_parser(subparsers):
                    help="the flight the result came from (CSV or log, read with its defaults): "
                         "adds test conditions, the calibration figure with residuals and the "
                         "ground track (the fit is re-run on it and checked against the result)")
+    p.add_argument("--start-s", type=float, default=None, metavar="S",
+                   help="with --flight: the window identify used (time_s >= S)")
+    p.add_argument("--end-s", type=float, default=None, metavar="S",
+                   help="with --flight: the window identify used (time_s <= S)")
+    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
+                   help="with --flight, logs only: the outside air temperature identify used")
     p.add_argument("--aircraft", metavar="AIRCRAFT.toml", default=None,
                    help="title block: [aircraft] type, registration, configuration, weight, cg; "
                         "[test] date, location, pilot, engineer, notes")
@@ -39,7 +45,7 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_output
+    from pitotcal.cli.common import check_output, oat_k_from_c
     from pitotcal.core.checks import choice
     from pitotcal.estimation.calibration_report import make_report
 
@@ -49,7 +55,8 @@ def run(args):
         if out is not None:
             check_output(option, out, source, "result JSON")
     options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
-    done = make_report(source, args.output, flight_path=args.flight,
+    read = {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c)}
+    done = make_report(source, args.output, flight_path=args.flight, flight_options=read,
                        aircraft_path=args.aircraft, regulation=args.regulation,
                        speed_range_kt=args.speed_range_kt, json_path=args.json,
                        pdf_path=args.pdf, options=options)
