@@ -108,7 +108,7 @@ def assess(result, regulation="23.1323", speed_range_kt=None):
     expanded = all(_finite(r.get("dv_U_kt")) for r in rows)
     grid = _grid(rows, lo, hi, flown)
     air = [_airspeed_row(r, reg, expanded) for r in grid]
-    alt = _altimeter(grid)
+    alt = _altimeter(grid, all(_finite(r.get("dh_ft")) for r in rows))
     return {
         "regulation": regulation, "title": reg["title"], "requirement": reg["requirement"],
         "basis": BASIS_NOTE,
@@ -189,9 +189,8 @@ def _airspeed_row(row, reg, expanded):
             "limit_kt": limit, "verdict": verdict, "reason": reason}
 
 
-def _altimeter(grid):
-    flown = [r for r in grid if r.get("flown") is not False]
-    if not flown or not all(_finite(r.get("dh_ft")) for r in flown):
+def _altimeter(grid, has_dh):
+    if not has_dh:
         return {"title": ALTIMETER_TITLE, "requirement": ALTIMETER_REQUIREMENT,
                 "verdict": NOT_DEMONSTRATED, "reason": "no static-source data (dh_ft)",
                 "rows": []}

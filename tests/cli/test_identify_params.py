@@ -62,3 +62,17 @@ def test_dataflash_end_to_end_mavproxy_file(flight, tmp_path, capsys):
     loaded.load(str(out))
     assert loaded["ARSPD_RATIO"] == pytest.approx(2.0 / (1.225 * 0.82), rel=4e-3)
     assert "current value 2;" in out.read_text()
+
+
+def test_arduplane_sitl_ratio_within_one_percent(shared_data, tmp_path):
+    from pymavlink.mavparm import MAVParmDict
+
+    log = shared_data / "ardupilot" / "arduplane_sitl.log"
+    out = tmp_path / "sitl.param"
+    assert main(["identify", str(log), "--oat-c", "15", "--params", str(out)]) == 0
+    loaded = MAVParmDict()
+    loaded.load(str(out))
+    ratio = loaded["ARSPD_RATIO"]
+    # measured: 1.99095 +/- 0.0087, -0.13 % from the simulator's 1.9936
+    assert abs(ratio / 1.9936 - 1.0) < 0.01
+    assert "current value 1.9936" in out.read_text()

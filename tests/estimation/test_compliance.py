@@ -94,3 +94,13 @@ def test_none_and_bad_arguments():
     with pytest.raises(PitotcalError, match="no airspeed_correction rows"):
         assess({"airspeed_correction": []}, "23.1323")
     assert flown_range_kcas(result_json(dv_kt=-1.0)) == (69.0, 99.0)
+
+
+def test_range_wholly_beyond_flown_has_no_verdict_but_not_demonstrated():
+    block = assess(result_json(dv_kt=-1.0, u_kt=0.5, dh_ft=5.0), "25.1323",
+                   speed_range_kt=(150.0, 200.0))
+    assert [r["vc_kt"] for r in block["airspeed"]["rows"]] == [150.0, 200.0]
+    assert block["verdict"] == "not demonstrated"
+    alt = block["altimeter"]
+    assert alt["verdict"] == "not demonstrated"
+    assert all("not extrapolated" in r["reason"] for r in alt["rows"])
