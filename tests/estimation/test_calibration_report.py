@@ -87,3 +87,21 @@ def test_read_result_refuses_other_files(tmp_path):
     bad.write_text('{"model": "inverse"}')
     with pytest.raises(PitotcalError, match="no airspeed_correction table"):
         read_result(bad)
+
+
+def test_a_flight_that_does_not_reproduce_the_result_is_a_warning():
+    from pitotcal.estimation import identify
+    from pitotcal.estimation.calibration_report import _reproduces
+    from synthetic import synthetic_flight
+
+    ident = identify(synthetic_flight(seed=7, n=1500)[0])
+    doc = ident.to_dict()
+    assert _reproduces(doc, ident) == []
+    doc["parameters"]["k1"]["value"] += 0.2 * doc["parameters"]["k1"]["std"]
+    (warning,) = _reproduces(doc, ident)
+    assert warning.startswith("the flight given does not reproduce the result (k1")
+
+
+def test_regulation_none_makes_no_statement():
+    html = _html(result_json(u_kt=1.0), regulation="none")
+    assert "No regulation chosen" in html and 'id="compliance-table"' not in html
