@@ -20,7 +20,7 @@ ratio is evaluated at the median q_ci flown (it then drifts by ~(V/a₀)²/4 acr
 0.1 % at 50 kt). The 2σ follows from k1's 2σ (delta method).
 
 Refusals (a `PitotcalError`, exit 2, one line): the track turned through less than
-`MIN_TRACK_SPREAD_DEG`; the inverse or linear model departs from the constant one by more than
+`MIN_TRACK_SPREAD_DEG`; the constant-model fit did not converge; the inverse or linear model departs from the constant one by more than
 its own 2σ somewhere in the flown range (one scale cannot represent the error: the scale right
 at cruise is wrong near the stall); the 2σ of the new value is wider than `TOLERANCE` of it
 while the current value lies inside that band (the flight cannot improve on it).
@@ -131,6 +131,9 @@ def recommend(flight, autopilot, current=None, *, gps_noise_std_mps=None, name=N
                             f"{spread:.0f} deg (need {MIN_TRACK_SPREAD_DEG:.0f} before "
                             f"committing {name}); fly a full circle")
     const = identify(flight, model="constant", gps_noise_std_mps=gps_noise_std_mps)
+    if not const.success:
+        raise PitotcalError(f"no parameter recommended: the constant-model fit did not "
+                            f"converge ({const.message})")
     departures, notes = _departures(flight, const, gps_noise_std_mps)
     for model, d in departures.items():
         if d["max_departure_kt"] > d["two_sigma_kt"]:

@@ -68,3 +68,19 @@ def test_refuses_bounds_too_wide_to_improve_on_the_current_value():
 def test_unknown_autopilot_is_refused(constant_flight):
     with pytest.raises(PitotcalError, match="ArduPilot or PX4 log"):
         recommend(constant_flight, None)
+
+
+def test_refuses_a_fit_that_did_not_converge(constant_flight, monkeypatch):
+    import dataclasses
+
+    from pitotcal.estimation import identification
+
+    real = identification.identify
+
+    def stalled(*args, **kw):
+        return dataclasses.replace(real(*args, **kw), success=False,
+                                   message="Maximum_Iterations_Exceeded")
+
+    monkeypatch.setattr(identification, "identify", stalled)
+    with pytest.raises(PitotcalError, match="did not converge \\(Maximum_Iterations"):
+        recommend(constant_flight, "ArduPilot", current=1.9936)
