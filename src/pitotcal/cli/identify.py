@@ -3,6 +3,8 @@
 Exit status: 0 success (also when the solver did not converge: the summary, the JSON's
 `converged: false` and a stderr warning say so); 2 unusable input, one stderr line naming
 file, column and row; 3 the data cannot separate the wind from the calibration.
+With `--params OUT`: 2 also when no parameter is recommended (one stderr line saying why,
+after the summary; the JSON and figure are written first).
 """
 
 from pathlib import Path
@@ -37,6 +39,14 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
+    # issue 10: the airspeed parameter an autopilot loads (logic in estimation/autopilot.py)
+    g = p.add_argument_group("autopilot parameters")
+    g.add_argument("--params", metavar="OUT", default=None,
+                   help="write the recommended airspeed parameter: for an ArduPilot log a "
+                        "Mission Planner / MAVProxy parameter file with ARSPD_RATIO, for a PX4 "
+                        "log a QGroundControl parameter file with ASPD_SCALE_1 (the current "
+                        "value and the 2-sigma as comments); exit 2 with the reason when the "
+                        "flight cannot support one")
     p.set_defaults(run=run)
 
 
@@ -54,14 +64,23 @@ def run(args):
         number("gps_noise_mps", args.gps_noise_mps, 0.0, 10.0, hi_open=True)
     source = Path(args.flight)
     # an output on top of the input, or one that cannot be written, is said before the work
-    for option, out in (("--json", args.json), ("--plot", args.plot)):
+    for option, out in (("--json", args.json), ("--plot", args.plot), ("--params", args.params)):
         if out is not None:
             check_output(option, out, source, "flight file")
     if args.plot is not None:
         _check_plot_format(args.plot)
 
-    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
-                         oat_k=oat_k_from_c(args.oat_c))
+    if args.params is None:
+        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                             oat_k=oat_k_from_c(args.oat_c))
+    else:
+        from pitotcal.io.param_files import read_flight_and_parameters
+        flight, autopilot, current = read_flight_and_parameters(
+            source, args.start_s, args.end_s, oat_k=oat_k_from_c(args.oat_c))
+        if autopilot is None:
+            from pitotcal.core.errors import PitotcalError
+            raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
+                                "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
     result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
@@ -79,7 +98,25 @@ def run(args):
         plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
         result.plot(plot_path)
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
+    if args.params is not None:
+        _write_params(args, flight, autopilot, current)
     return 0
+
+
+def _write_params(args, flight, autopilot, current):
+    """The recommended airspeed parameter, or a PitotcalError (exit 2) saying why not."""
+    from pitotcal.estimation.autopilot import PARAMETER, recommend, write_parameter_file
+
+    name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
+        if autopilot == "PX4" else None
+    rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
+                    gps_noise_std_mps=args.gps_noise_mps, name=name)
+    write_parameter_file(rec, args.params)
+    print(f"\nRecommended {rec.name} = {rec.value:.4f} ± {rec.two_sigma:.4f} (2σ)"
+          + ("" if rec.current is None else f", now {rec.current:.6g}")
+          + f"; wrote {args.params}")
+    for note in rec.notes:
+        print(f"  note: {note}")
 
 
 def _write_json(path, result, flight, source):
