@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from pitotcal.core.models import get_model
-from pitotcal.core.units import RHO0_KGM3, cas_from_qc_mps, mps_to_kt
+from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, mps_to_kt
 from pitotcal.io.jsonfile import json_ready
 
 __all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary", "to_dict"]
@@ -31,7 +31,7 @@ def flown_vi_kt(result):
     qci = qci[np.isfinite(qci) & (qci > 0)]
     if qci.size == 0:
         raise ValueError("the result holds no positive q_ci samples")
-    vi = mps_to_kt(cas_from_qc_mps(np.array([qci.min(), qci.max()])))
+    vi = mps_to_kt(incompressible_cas_mps(np.array([qci.min(), qci.max()])))
     return float(vi[0]), float(vi[1])
 
 
@@ -290,7 +290,7 @@ def _plot_distribution(ax, result):
     ax.set_xlim(max(0.0, q_lo - margin), q_hi + margin)
     ax.set(xlabel="q_ci (Pa)", ylabel="samples", title="Data distribution")
     ax_v = ax.secondary_xaxis(
-        "top", functions=(lambda q: mps_to_kt(cas_from_qc_mps(q)),
+        "top", functions=(lambda q: mps_to_kt(incompressible_cas_mps(q)),
                           lambda v: 0.5 * RHO0_KGM3 * (np.asarray(v) / mps_to_kt(1.0)) ** 2))
     ax_v.set_xlabel("V_i (kt)")
 

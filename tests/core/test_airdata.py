@@ -180,7 +180,7 @@ def incompressible_bias_kt(cas_kt, alt_ft):
     qc = ad.qc_from_cas_pa(np.asarray(cas_kt) * KT)
     tas = ad.mach_from_qc(qc, ps) * ad.speed_of_sound_mps(oat)
     eas = tas * np.sqrt(units.density_kgm3(ps, oat) / units.RHO0_KGM3)
-    return (eas - units.cas_from_qc_mps(qc)) / KT, tas / KT
+    return (eas - units.incompressible_cas_mps(qc)) / KT, tas / KT
 
 
 def test_incompressible_bias_of_a_perfect_system():
