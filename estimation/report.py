@@ -14,9 +14,12 @@ import math
 
 import numpy as np
 
+from pitotcal.core import airdata
 from pitotcal.core.models import get_model
-from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, mps_to_kt
+from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, kt_to_mps, m_to_ft, mps_to_kt
 from pitotcal.io.jsonfile import json_ready
+
+from .static_source import ASSUMED_STATIC, pressure_altitude_ic_m, static_source_products
 
 __all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary", "to_dict"]
 
@@ -25,13 +28,33 @@ _WIND_UNITS = {"wind_speed_mps": "m/s", "wind_from_deg": "deg"}
 _MAX_POINTS = 4000           # samples drawn as faint points: enough to see the cloud, cheap
 
 
+def _compressible(result):
+    return getattr(result, "air_data", "incompressible") == "compressible"
+
+
+def airspeed_kt(result, qc_pa):
+    """The airspeed of impact pressures, kt, by the result's law: the standard calibrated
+    airspeed (compressible) or sqrt(2 q / rho0) (incompressible)."""
+    if _compressible(result):
+        return mps_to_kt(airdata.cas_from_qc_mps(qc_pa))
+    return mps_to_kt(incompressible_cas_mps(qc_pa))
+
+
+def _qc_of_airspeed_pa(result, v_kt):
+    v = kt_to_mps(np.asarray(v_kt, dtype=float))
+    if _compressible(result):
+        return airdata.qc_from_cas_pa(np.abs(v)) * np.sign(v)
+    return 0.5 * RHO0_KGM3 * v ** 2
+
+
 def flown_vi_kt(result):
-    """(lowest, highest) indicated airspeed V_i = sqrt(2 q_ci / rho0) flown, kt."""
+    """(lowest, highest) indicated airspeed V_i flown, kt: sqrt(2 q_ci / rho0), or the
+    standard CAS of q_ci (V_ic) for a compressible result."""
     qci = np.asarray(result.qci_pa, dtype=float)
     qci = qci[np.isfinite(qci) & (qci > 0)]
     if qci.size == 0:
         raise ValueError("the result holds no positive q_ci samples")
-    vi = mps_to_kt(incompressible_cas_mps(np.array([qci.min(), qci.max()])))
+    vi = airspeed_kt(result, np.array([qci.min(), qci.max()]))
     return float(vi[0]), float(vi[1])
 
 
@@ -58,7 +81,10 @@ def correction_table(result, step_kt=None):
         Rows {vi_kt, dv_kt, dv_2sigma_kt, dv_2sigma_plain_kt, vc_kt}: indicated airspeed V_i,
         correction ΔV = V_c - V_i and its 2-sigma (corrected, and plain Hessian), calibrated
         V_c = V_i + ΔV, all kt. The first and last rows are the lowest and highest V_i flown
-        (rounded inward to 0.1 kt); between them the multiples of `step_kt`.
+        (rounded inward to 0.1 kt); between them the multiples of `step_kt`. A compressible
+        result's rows (V_i = V_ic, ΔV = ΔV_pc) add the static-source products of
+        `estimation.static_source`: mach_i, dmach, dmach_2sigma, dh_ft, dh_2sigma_ft,
+        dpp_qcic, dpp_qcic_2sigma.
     """
     lo, hi = flown_vi_kt(result)
     if step_kt is None:
@@ -72,10 +98,19 @@ def correction_table(result, step_kt=None):
     grid = np.unique(np.concatenate([[lo_r], inner[(inner > lo_r) & (inner < hi_r)], [hi_r]]))
     dv, band = result.delta_v_kt(grid)
     _, band_plain = result.delta_v_kt(grid, plain=True)
-    return [{"vi_kt": float(v), "dv_kt": float(d), "dv_2sigma_kt": float(b),
+    rows = [{"vi_kt": float(v), "dv_kt": float(d), "dv_2sigma_kt": float(b),
              "dv_2sigma_plain_kt": float(bp), "vc_kt": float(v + d)}
             for v, d, b, bp in zip(grid, np.atleast_1d(dv), np.atleast_1d(band),
                                    np.atleast_1d(band_plain))]
+    if _compressible(result) and result.ps_pa is not None:
+        extra = static_source_products(result, grid)
+        for i, row in enumerate(rows):
+            row.update({key: float(np.atleast_1d(extra[key])[i]) for key in _STATIC_KEYS})
+    return rows
+
+
+_STATIC_KEYS = ("mach_i", "dmach", "dmach_2sigma", "dh_ft", "dh_2sigma_ft", "dpp_qcic",
+                "dpp_qcic_2sigma")
 
 
 def to_dict(result):
@@ -114,7 +149,13 @@ def to_dict(result):
         "candidates": list(result.candidates),
         "criterion": result.criterion,
         "timing_s": dict(result.timing_s),
+        "air_data": result.air_data,
     }
+    if _compressible(result):
+        h_ic = pressure_altitude_ic_m(result)
+        out["static_source"] = {
+            "assumed": ASSUMED_STATIC,
+            "pressure_altitude_ic_ft": None if h_ic is None else float(m_to_ft(h_ic))}
     return json_ready(out)
 
 
@@ -162,13 +203,20 @@ def summary(result):
         (f"  {'wind from':<14}{f'{frm:.1f}°':>12}{'±' + _fmt(frm2, 2) + '°':>12}"
          f"{'(±' + _fmt(frm2p, 2) + '°)':>14}   true, the direction it blows from"),
         "",
+    ]
+    table = correction_table(result)
+    if _compressible(result):
+        lines += _air_data_lines(result)
+    lines += [
         "Airspeed correction, ΔV = V_c - V_i (add ΔV to the indicated airspeed):",
         f"  {'KIAS':>7}{'ΔV kt':>9}{'±2σ kt':>9}{'(plain)':>9}{'KCAS':>8}",
     ]
-    for row in correction_table(result):
+    for row in table:
         lines.append(f"  {row['vi_kt']:7.1f}{row['dv_kt']:+9.2f}{row['dv_2sigma_kt']:9.2f}"
                      f"{'(' + format(row['dv_2sigma_plain_kt'], '.2f') + ')':>9}"
                      f"{row['vc_kt']:8.1f}")
+    if table and "dh_ft" in table[0]:
+        lines += _static_table(result, table)
     if result.candidates:
         crit = result.criterion or "criterion"
         lines += ["", f"Candidate structures ({crit}; lowest chosen):"]
@@ -182,6 +230,33 @@ def summary(result):
     if result.warnings:
         lines += ["", "Warnings:"] + [f"  - {w}" for w in result.warnings]
     return "\n".join(lines)
+
+
+def _air_data_lines(result):
+    """The compressible summary's statement of what was computed and assumed."""
+    return [
+        ("Air data: compressible (isentropic q_c from V_t, the static port's p_s and T_s); "
+         "KIAS = V_ic and KCAS = V_c by the standard CAS law, ΔV = ΔV_pc."),
+        f"Assumed: {ASSUMED_STATIC}.",
+        "",
+    ]
+
+
+def _static_table(result, table):
+    """Static-source position error per row: Δp_p/q_cic, M_ic, ΔM_pc, ΔH_pc with 2σ."""
+    h_ic = pressure_altitude_ic_m(result)
+    lines = [
+        "",
+        (f"Static-source position error (altimeter correction at the flight's median pressure "
+         f"altitude {m_to_ft(h_ic):.0f} ft):"),
+        (f"  {'KIAS':>7}{'M_ic':>8}{'Δp_p/q_cic':>12}{'±2σ':>9}{'ΔM_pc':>9}{'±2σ':>9}"
+         f"{'ΔH_pc ft':>10}{'±2σ':>7}"),
+    ]
+    for row in table:
+        lines.append(f"  {row['vi_kt']:7.1f}{row['mach_i']:8.4f}{row['dpp_qcic']:+12.4f}"
+                     f"{row['dpp_qcic_2sigma']:9.4f}{row['dmach']:+9.4f}"
+                     f"{row['dmach_2sigma']:9.5f}{row['dh_ft']:+10.1f}{row['dh_2sigma_ft']:7.1f}")
+    return lines
 
 
 # --- figure -----------------------------------------------------------------------------

@@ -8,6 +8,7 @@ file, column and row; 3 the data cannot separate the wind from the calibration.
 from pathlib import Path
 
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
+AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_DATA_MODES
 
 
 def add_parser(subparsers):
@@ -23,6 +24,15 @@ def add_parser(subparsers):
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
+    # --- air data (issue 9) ---
+    p.add_argument("--air", default="compressible", metavar="MODE",
+                   help="how impact pressure follows from true airspeed: compressible "
+                        "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
+                        "all pressure error taken in the static source; V_i, V_c standard "
+                        "CAS) or incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
+                        "paper's eq. 2 and the results before issue 9); a flight without "
+                        "ps_pa/oat_k is fitted incompressible with a warning; default "
+                        "%(default)s")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
@@ -50,6 +60,7 @@ def run(args):
     from pitotcal.io import is_log_file, read_flight
 
     choice("model", args.model, [*MODELS, "auto"])
+    choice("air", args.air, AIR_CHOICES)
     if args.gps_noise_mps is not None:
         number("gps_noise_mps", args.gps_noise_mps, 0.0, 10.0, hi_open=True)
     source = Path(args.flight)
@@ -62,7 +73,8 @@ def run(args):
 
     flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
                          oat_k=oat_k_from_c(args.oat_c))
-    result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
+    result = identify(flight, model=args.model, air=args.air,
+                      gps_noise_std_mps=args.gps_noise_mps)
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
