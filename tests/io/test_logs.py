@@ -57,7 +57,7 @@ def test_reader_recovers_written_flight_and_calibration(kind, tmp_path, truth_fl
     np.testing.assert_allclose(got.gps_vn_mps, np.interp(got.time_s - offset, flight.time_s,
                                                          flight.gps_vn_mps), atol=0.01)
     assert got.gps_vd_mps is not None and got.n >= flight.n - 2
-    result = identify(got, "inverse")
+    result = identify(got, "inverse", air="incompressible")   # the truth is q_c = rho V^2 / 2
     p = truth["parameters"]
     assert result.value("k1") == pytest.approx(p["k1"], abs=2e-3)
     assert result.value("k2") == pytest.approx(p["k2"], abs=1.5)
