@@ -16,10 +16,16 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.models import get_model
-from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, kt_to_mps, m_to_ft, mps_to_kt
+from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, m_to_ft, mps_to_kt
 from pitotcal.io.jsonfile import json_ready
 
-from .static_source import ASSUMED_STATIC, pressure_altitude_ic_m, static_source_products
+from .static_source import (
+    ASSUMED_STATIC,
+    plot_altimeter_correction,
+    plot_static_error,
+    pressure_altitude_ic_m,
+    static_source_products,
+)
 
 __all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary", "to_dict"]
 
@@ -38,13 +44,6 @@ def airspeed_kt(result, qc_pa):
     if _compressible(result):
         return mps_to_kt(airdata.cas_from_qc_mps(qc_pa))
     return mps_to_kt(incompressible_cas_mps(qc_pa))
-
-
-def _qc_of_airspeed_pa(result, v_kt):
-    v = kt_to_mps(np.asarray(v_kt, dtype=float))
-    if _compressible(result):
-        return airdata.qc_from_cas_pa(np.abs(v)) * np.sign(v)
-    return 0.5 * RHO0_KGM3 * v ** 2
 
 
 def flown_vi_kt(result):
@@ -283,7 +282,9 @@ def plot(result, path=None):
 
     Four panels: ΔV vs V_i with the 2-sigma band (plain Hessian band dashed); Δp/q_c vs q_ci
     with its band and the per-sample ratio implied by the residuals as faint points; the
-    q_ci distribution; the residual time history. The wind is in the title.
+    q_ci distribution; the residual time history. The wind is in the title. A compressible
+    result shows Δp_p/q_cic vs M_ic and ΔH_pc vs V_ic (`estimation.static_source`) in place
+    of the second and third.
 
     Parameters
     ----------
@@ -300,12 +301,19 @@ def plot(result, path=None):
     fig = Figure(figsize=(12, 8.5), layout="constrained")
     ax_dv, ax_dp, ax_hist, ax_res = fig.subplots(2, 2).ravel()
     _plot_correction(ax_dv, result)
-    _plot_pressure_error(ax_dp, result)
-    _plot_distribution(ax_hist, result)
+    if _compressible(result) and result.ps_pa is not None:
+        # the static-source products in place of Δp/q_c vs q_ci and the q_ci histogram
+        g = _implied_ratio(result, get_model(result.model))[1]
+        plot_static_error(ax_dp, result, g, flown_vi_kt(result))
+        plot_altimeter_correction(ax_hist, result, flown_vi_kt(result))
+    else:
+        _plot_pressure_error(ax_dp, result)
+        _plot_distribution(ax_hist, result)
     _plot_residuals(ax_res, result)
     spd, spd2, _, frm, frm2, _ = _wind(result)
     state = "" if result.converged else "   [SOLVER DID NOT CONVERGE]"
-    fig.suptitle(f"{result.model} model, {result.n_samples} samples — wind {spd:.1f} ± {spd2:.1f}"
+    air = " (compressible, V_i = V_ic)" if _compressible(result) else ""
+    fig.suptitle(f"{result.model} model{air}, {result.n_samples} samples — wind {spd:.1f} ± {spd2:.1f}"
                  f" kt from {frm:.0f}° ± {frm2:.1f}° (2σ){state}", fontsize=13)
     if path is not None:
         fig.savefig(path, dpi=110)

@@ -6,6 +6,8 @@ import numpy as np
 
 from pitotcal.core.models import delta_v_kt, get_model
 
+from .propagation import band as _band
+from .propagation import gradient as _gradient
 from .unknowns import COEFS
 
 __all__ = ["IdentificationResult"]
@@ -159,21 +161,3 @@ class IdentificationResult:
     def _coef_cov(self, plain):
         cov = self.internal_covariance_plain if plain else self.internal_covariance
         return cov[COEFS, COEFS]
-
-
-def _gradient(fun, k):
-    """Central-difference gradient of a vector function of the coefficients, shape (len(k), ...)."""
-    k = np.asarray(k, dtype=float)
-    rows = []
-    for i in range(k.size):
-        h = 1e-6 * max(1.0, abs(k[i]))
-        up, dn = k.copy(), k.copy()
-        up[i] += h
-        dn[i] -= h
-        rows.append((fun(up) - fun(dn)) / (2 * h))
-    return np.array(rows)
-
-
-def _band(grad, cov):
-    """One-sigma of a derived quantity: sqrt(g^T C g) for each column of `grad`."""
-    return np.sqrt(np.maximum(np.einsum("i...,ij,j...->...", grad, cov, grad), 0.0))

@@ -308,9 +308,8 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         True impact pressure from the true airspeed: ½ρV_t² (the paper's eq. 2, the default)
         or isentropic, q_c = p_s[(1 + 0.2M²)^3.5 − 1] with the ISA static pressure and
         temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
-        Compressible flights also carry `ps_pa`, the static port's reading p_s + Δp_p (all
-        the pressure error in the static source: Δp_p = q_c − q_ci), and `oat_k`, the ISA
-        static temperature. The autopilot flies the plan's true airspeed either way.
+        Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
+        `oat_k`. The autopilot flies the plan's true airspeed either way.
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -322,8 +321,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     Returns
     -------
     flight : pitotcal.core.flight.Flight
-        time_s, qci_pa, gps_vn/ve/vd_mps, rho_kgm3 (ISA at the altitude flown), alt_m
-        (and ps_pa, oat_k when compressible).
+        time_s, qci_pa, gps_vn/ve/vd_mps, rho_kgm3 (ISA at the altitude flown), alt_m.
     truth : maneuvers.truth.Truth
         The true calibration and mean wind flown, the options, and the tracking errors.
 
