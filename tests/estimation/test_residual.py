@@ -132,3 +132,10 @@ def test_spread_weights_are_the_spread_gradient(air_data):
     c, w = spread_weights(model, theta, ch)
     got = [c * np.sum(w * (d["vn"] - theta[-2])), c * np.sum(w * (d["ve"] - theta[-1]))]
     np.testing.assert_allclose(got, -0.5 * grad[-2:], rtol=1e-9)
+
+
+def test_compressible_graph_size_does_not_grow_with_n():
+    model = get_model("inverse")
+    small, large = (objective_function(model, n, False, "compressible").n_nodes()
+                    for n in (10, 1_000_000))
+    assert small == large < 80
