@@ -46,7 +46,10 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
         temperature `oat_k`, with all the pressure error in the static source (the default),
         or the paper's eq. 2, q_c = ½ρV_t² ("incompressible", results as before issue 9). A
-        flight without `ps_pa` and `oat_k` is fitted incompressible with a warning.
+        flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
+        an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
+        it instead, and the static and total pressure errors are separated
+        (`estimation.static_source`).
     gps_noise_std_mps : float, optional
         GPS velocity noise per component, m/s, for the errors-in-variables correction;
         estimated from the data when None.
@@ -162,6 +165,9 @@ def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data):
 
 def _air_data(flight, air):
     """(the air-data mode used, warnings): compressible needs the flight's ps_pa and oat_k."""
+    if air == "compressible" and flight.ps_ref_pa is not None and flight.ps_pa is not None \
+            and flight.oat_k is not None:
+        return "reference", ()
     if air == "compressible" and (flight.ps_pa is None or flight.oat_k is None):
         return "incompressible", ((
             f"{flight.source}: no static pressure and temperature (ps_pa, oat_k): fitted with "
@@ -175,7 +181,8 @@ def _check_flight(flight, air_data="incompressible"):
     n = flight.n
     if n < MIN_SAMPLES:
         raise FlightDataError(f"{flight.source}: {n} samples; identification needs at least {MIN_SAMPLES}")
-    air = ("ps_pa", "oat_k") if air_data == "compressible" else ()
+    air = {"compressible": ("ps_pa", "oat_k"),
+           "reference": ("ps_pa", "oat_k", "ps_ref_pa")}.get(air_data, ())
     for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", *air):
         values = getattr(flight, name)
         if values is None:

@@ -27,6 +27,7 @@ from .covariance import ColoredCovariance, colored_covariance, plain_covariance
 from .iv import IV_WINDOW_S, iv_refine, smooth_in_time
 from .residual import (
     AIR_CHANNELS,
+    ReferenceAir,
     flight_channels,
     impact_pressure,
     is_compressible,
@@ -201,9 +202,10 @@ class OutputErrorProblem:
         start : ndarray, optional
             Start values (k..., wind_n_mps, wind_e_mps); the linear least-squares start
             (`start_values`) when None.
-        air_data : {"incompressible", "compressible"}
-            How q_c follows from V_t (`estimation.residual`); "compressible" needs the
-            flight's `ps_pa` and `oat_k` (`estimation.identify` checks and chooses).
+        air_data : {"incompressible", "compressible", "reference"}
+            How q_c follows from V_t (`estimation.residual`): "compressible" from the
+            flight's `ps_pa` + q_ci and `oat_k`, "reference" from its `ps_ref_pa` and
+            `oat_k` (`estimation.identify` checks and chooses; both report "compressible").
 
         Returns
         -------
@@ -234,7 +236,7 @@ def _minimise(model, built, ch, theta0):
     s0 = 1.4826 * np.median(np.abs(r0 - np.median(r0)))
     s0 = max(s0, 1e-6 * float(np.mean(ch.qci)), 1e-9)
     values = {"qci": ch.qci, "vn": ch.vn, "ve": ch.ve, "rho": ch.rho, "vd2": ch.vd2,
-              "pt": ch.pt, "oat": ch.oat,
+              "pt": ch.pt, "oat": ch.oat, "ps_ref": ch.ps_ref,
               "c_eiv": ch.c_eiv, "pen_a": 4.0 * ch.var_v,
               "pen_b": 2.0 * ch.n_comp * ch.var_v ** 2, "weight": 1.0 / s0 ** 2}
     p_val = ca.DM(np.concatenate([np.atleast_1d(values[name]) for name in built.p_names]))
@@ -296,8 +298,9 @@ def _result(model, flight, ch, fit, stats, timing, air_data="incompressible"):
         rho_kgm3=flight.rho_kgm3,
         residuals_pa=fit.residuals,
         warnings=warn,
-        air_data=air_data,
-        ps_pa=flight.ps_pa if air_data == "compressible" else None,
+        air_data="incompressible" if air_data == "incompressible" else "compressible",
+        ps_pa=flight.ps_pa if air_data != "incompressible" else None,
+        ps_ref_pa=flight.ps_ref_pa if air_data == "reference" else None,
         timing_s=timing,
     )
 
@@ -336,7 +339,7 @@ def start_values(model, qci_pa, vn_mps, ve_mps, air, vd2=None, c_eiv=0.0):
     fit of the per-sample ratio 1 - q_ci / q_c(W) to the model.
     """
     if is_compressible(air):
-        y = _tas_sq_of_qc(qci_pa, *air)                    # about (1 - f) V_t^2
+        y = _tas_sq_of_qc(qci_pa, air)                     # about (1 - f) V_t^2
     else:
         y = qci_pa / impact_pressure_pa(air, 1.0)          # (1 - f) V_t^2
     v2g = tas_squared(vn_mps, ve_mps, 0.0, 0.0, vd2) - c_eiv  # |V_g|^2 - c_eiv
@@ -363,10 +366,11 @@ def start_values(model, qci_pa, vn_mps, ve_mps, air, vd2=None, c_eiv=0.0):
     return np.concatenate([k, [wn, we]])
 
 
-def _tas_sq_of_qc(qc_pa, pt_pa, oat_k):
-    """V_t^2 whose impact pressure at total pressure p_T and temperature T_s is q_c."""
-    mach = mach_from_qc(qc_pa, pt_pa - qc_pa)
-    return mach * np.abs(mach) * GAMMA * R_AIR_JKGK * oat_k
+def _tas_sq_of_qc(qc_pa, air):
+    """V_t^2 whose impact pressure is q_c with the compressible air data `air`."""
+    ps = air.ps if isinstance(air, ReferenceAir) else air.pt - qc_pa
+    mach = mach_from_qc(qc_pa, ps)
+    return mach * np.abs(mach) * GAMMA * R_AIR_JKGK * air.oat
 
 
 def _gap_warning(time_s):

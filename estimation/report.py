@@ -20,11 +20,13 @@ from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, m_to_ft, mps_
 from pitotcal.io.jsonfile import json_ready
 
 from .static_source import (
-    ASSUMED_STATIC,
+    air_data_lines,
     plot_altimeter_correction,
     plot_static_error,
     pressure_altitude_ic_m,
     static_source_products,
+    static_statement,
+    static_table_lines,
 )
 
 __all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary", "to_dict"]
@@ -103,13 +105,15 @@ def correction_table(result, step_kt=None):
                                    np.atleast_1d(band_plain))]
     if _compressible(result) and result.ps_pa is not None:
         extra = static_source_products(result, grid)
+        keys = _STATIC_KEYS + (_REFERENCE_KEYS if "dpt_qcic" in extra else ())
         for i, row in enumerate(rows):
-            row.update({key: float(np.atleast_1d(extra[key])[i]) for key in _STATIC_KEYS})
+            row.update({key: float(np.atleast_1d(extra[key])[i]) for key in keys})
     return rows
 
 
 _STATIC_KEYS = ("mach_i", "dmach", "dmach_2sigma", "dh_ft", "dh_2sigma_ft", "dpp_qcic",
                 "dpp_qcic_2sigma")
+_REFERENCE_KEYS = ("dpt_qcic", "dpt_qcic_2sigma")
 
 
 def to_dict(result):
@@ -152,9 +156,12 @@ def to_dict(result):
     }
     if _compressible(result):
         h_ic = pressure_altitude_ic_m(result)
+        statement, fit = static_statement(result)
         out["static_source"] = {
-            "assumed": ASSUMED_STATIC,
+            "assumed": statement,
             "pressure_altitude_ic_ft": None if h_ic is None else float(m_to_ft(h_ic))}
+        if fit is not None:
+            out["static_source"]["k_static"] = fit
     return json_ready(out)
 
 
@@ -205,7 +212,7 @@ def summary(result):
     ]
     table = correction_table(result)
     if _compressible(result):
-        lines += _air_data_lines(result)
+        lines += air_data_lines(result)
     lines += [
         "Airspeed correction, ΔV = V_c - V_i (add ΔV to the indicated airspeed):",
         f"  {'KIAS':>7}{'ΔV kt':>9}{'±2σ kt':>9}{'(plain)':>9}{'KCAS':>8}",
@@ -215,7 +222,7 @@ def summary(result):
                      f"{'(' + format(row['dv_2sigma_plain_kt'], '.2f') + ')':>9}"
                      f"{row['vc_kt']:8.1f}")
     if table and "dh_ft" in table[0]:
-        lines += _static_table(result, table)
+        lines += static_table_lines(result, table)
     if result.candidates:
         crit = result.criterion or "criterion"
         lines += ["", f"Candidate structures ({crit}; lowest chosen):"]
@@ -229,33 +236,6 @@ def summary(result):
     if result.warnings:
         lines += ["", "Warnings:"] + [f"  - {w}" for w in result.warnings]
     return "\n".join(lines)
-
-
-def _air_data_lines(result):
-    """The compressible summary's statement of what was computed and assumed."""
-    return [
-        ("Air data: compressible (isentropic q_c from V_t, the static port's p_s and T_s); "
-         "KIAS = V_ic and KCAS = V_c by the standard CAS law, ΔV = ΔV_pc."),
-        f"Assumed: {ASSUMED_STATIC}.",
-        "",
-    ]
-
-
-def _static_table(result, table):
-    """Static-source position error per row: Δp_p/q_cic, M_ic, ΔM_pc, ΔH_pc with 2σ."""
-    h_ic = pressure_altitude_ic_m(result)
-    lines = [
-        "",
-        (f"Static-source position error (altimeter correction at the flight's median pressure "
-         f"altitude {m_to_ft(h_ic):.0f} ft):"),
-        (f"  {'KIAS':>7}{'M_ic':>8}{'Δp_p/q_cic':>12}{'±2σ':>9}{'ΔM_pc':>9}{'±2σ':>9}"
-         f"{'ΔH_pc ft':>10}{'±2σ':>7}"),
-    ]
-    for row in table:
-        lines.append(f"  {row['vi_kt']:7.1f}{row['mach_i']:8.4f}{row['dpp_qcic']:+12.4f}"
-                     f"{row['dpp_qcic_2sigma']:9.4f}{row['dmach']:+9.4f}"
-                     f"{row['dmach_2sigma']:9.5f}{row['dh_ft']:+10.1f}{row['dh_2sigma_ft']:7.1f}")
-    return lines
 
 
 # --- figure -----------------------------------------------------------------------------

@@ -25,20 +25,42 @@ sensitivities, the instrumental-variable steps) and build the problem's MX graph
 """
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-from pitotcal.core.airdata import qc_from_total_derivatives, qc_from_total_pa
+from pitotcal.core.airdata import (
+    qc_from_tas_sq_derivatives,
+    qc_from_tas_sq_pa,
+    qc_from_total_derivatives,
+    qc_from_total_pa,
+)
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 
 from .eiv import estimate_gps_noise_std, interpolate_held
 from .unknowns import COEFS, WIND_E, WIND_N
 
 __all__ = [
-    "AIR_CHANNELS", "Channels", "flight_channels", "impact_pressure", "is_compressible",
+    "AIR_CHANNELS", "Channels", "ReferenceAir", "TotalAir", "flight_channels", "impact_pressure", "is_compressible",
     "ratio_columns", "residual", "residual_function", "residual_terms", "sensitivities",
     "slope", "spread_weights",
 ]
+
+
+class TotalAir(NamedTuple):
+    """Compressible air data with all the pressure error in the static source: the measured
+    total pressure p_T = p_s,ind + q_ci (Pa) and the static temperature (K)."""
+
+    pt: object
+    oat: object
+
+
+class ReferenceAir(NamedTuple):
+    """Compressible air data from an independent reference static pressure p_s (Pa) and the
+    static temperature (K): no assumption on where the pressure error is."""
+
+    ps: object
+    oat: object
 
 
 @dataclass(frozen=True)
@@ -46,9 +68,9 @@ class Channels:
     """A flight's data as the residual uses it, SI, arrays of shape (N,).
 
     GPS velocity is interpolated where the log held it (`estimation.eiv.interpolate_held`);
-    `var_v` is the GPS noise variance per component after that interpolation. `pt` (total
-    pressure p_s,ind + q_ci, Pa) and `oat` (static temperature, K) are set for the
-    compressible problem only.
+    `var_v` is the GPS noise variance per component after that interpolation. `oat` (static
+    temperature, K) and either `pt` (total pressure p_s,ind + q_ci, Pa) or `ps_ref` (a
+    reference static pressure, Pa) are set for the compressible problem only.
     """
 
     qci: np.ndarray
@@ -61,6 +83,7 @@ class Channels:
     n_comp: int          # velocity components: 2, or 3 with a vertical speed
     pt: np.ndarray | None = None
     oat: np.ndarray | None = None
+    ps_ref: np.ndarray | None = None
 
     @property
     def c_eiv(self):
@@ -69,8 +92,10 @@ class Channels:
 
     @property
     def air(self):
-        """The air data of the prediction: rho (incompressible) or the pair (p_T, T_s)."""
-        return self.rho if self.pt is None else (self.pt, self.oat)
+        """The air data of the prediction: rho (incompressible), `TotalAir` or `ReferenceAir`."""
+        if self.ps_ref is not None:
+            return ReferenceAir(self.ps_ref, self.oat)
+        return self.rho if self.pt is None else TotalAir(self.pt, self.oat)
 
     @property
     def args(self):
@@ -82,7 +107,7 @@ def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible"):
     """The `Channels` of `flight`; sigma_v estimated from the data when not given.
 
     With `air_data` "compressible" the flight must carry `ps_pa` and `oat_k`
-    (`estimation.identify` checks it).
+    (`estimation.identify` checks it); "reference" uses its `ps_ref_pa` and `oat_k`.
     """
     gps = (flight.gps_vn_mps, flight.gps_ve_mps)
     if flight.gps_vd_mps is not None:
@@ -95,14 +120,25 @@ def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible"):
     extra = {}
     if air_data == "compressible":
         extra = {"pt": flight.ps_pa + flight.qci_pa, "oat": np.asarray(flight.oat_k, float)}
+    elif air_data == "reference":
+        extra = {"ps_ref": np.asarray(flight.ps_ref_pa, float),
+                 "oat": np.asarray(flight.oat_k, float)}
     return Channels(qci=flight.qci_pa, vn=vel[0], ve=vel[1], rho=flight.rho_kgm3,
                     vd2=vel[2] ** 2 if len(vel) == 3 else None, sigma_v=float(sigma_v),
                     var_v=noise_factor * sigma_v ** 2, n_comp=len(vel), **extra)
 
 
 def is_compressible(air):
-    """Whether `air` is the compressible pair (p_T, T_s) rather than a density."""
+    """Whether `air` is compressible air data (`TotalAir`, `ReferenceAir`), not a density."""
     return isinstance(air, tuple)
+
+
+def _derivatives(air, tas_sq):
+    """(dq_c/dV_t^2, d^2q_c/d(V_t^2)^2) of the compressible prediction."""
+    lib = _lib(air[0])
+    if isinstance(air, ReferenceAir):
+        return qc_from_tas_sq_derivatives(tas_sq, *air, lib)
+    return qc_from_total_derivatives(tas_sq, *air, lib)          # TotalAir, or a plain pair
 
 
 def _lib(x):
@@ -117,10 +153,12 @@ def impact_pressure(air, tas_sq):
     """(q_c, dq_c/dV_t^2) predicted at V_t^2 = `tas_sq` from the air data `air`."""
     if not is_compressible(air):
         return impact_pressure_pa(air, tas_sq), impact_pressure_pa(air, 1.0)
-    pt, oat = air
-    lib = _lib(pt)
-    return (qc_from_total_pa(tas_sq, pt, oat, lib),
-            qc_from_total_derivatives(tas_sq, pt, oat, lib)[0])
+    lib = _lib(air[0])
+    if isinstance(air, ReferenceAir):
+        qc = qc_from_tas_sq_pa(tas_sq, *air, lib)
+    else:
+        qc = qc_from_total_pa(tas_sq, *air, lib)
+    return qc, _derivatives(air, tas_sq)[0]
 
 
 def slope(model, k, qci, air, tas_sq=None, c_eiv=0.0):
@@ -186,7 +224,7 @@ def spread_weights(model, theta, ch):
         return 4.0 * ch.var_v, slope(model, k, ch.qci, ch.rho) ** 2
     tas_sq = tas_squared(ch.vn, ch.ve, theta[WIND_N], theta[WIND_E], ch.vd2)
     gain = 1.0 - model(k, ch.qci)
-    d1, d2 = qc_from_total_derivatives(tas_sq - ch.c_eiv, ch.pt, ch.oat)
+    d1, d2 = _derivatives(ch.air, tas_sq - ch.c_eiv)
     a = gain * d1
     spread = 4.0 * ch.var_v * tas_sq - 2.0 * ch.n_comp * ch.var_v ** 2
     return 1.0, 4.0 * ch.var_v * a ** 2 + 2.0 * a * gain * d2 * spread
@@ -251,7 +289,8 @@ def residual_function(model, n, has_vd, air_data="incompressible"):
     qci, vn, ve = (ca.MX.sym(name, n) for name in ("qci", "vn", "ve"))
     names = AIR_CHANNELS[air_data]
     air_syms = [ca.MX.sym(name, n) for name in names]
-    air = air_syms[0] if len(air_syms) == 1 else tuple(air_syms)
+    air = {"compressible": TotalAir, "reference": ReferenceAir}.get(
+        air_data, lambda rho: rho)(*air_syms)
     vd2 = ca.MX.sym("vd2", n if has_vd else 1)
     c_eiv = ca.MX.sym("c_eiv")
     r, a, tas_sq = residual_terms(model, theta, qci, vn, ve, air, vd2, c_eiv)
@@ -261,4 +300,5 @@ def residual_function(model, n, has_vd, air_data="incompressible"):
 
 
 # The data channels of the air, per mode (`Channels.air`).
-AIR_CHANNELS = {"incompressible": ("rho",), "compressible": ("pt", "oat")}
+AIR_CHANNELS = {"incompressible": ("rho",), "compressible": ("pt", "oat"),
+                "reference": ("ps_ref", "oat")}

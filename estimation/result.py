@@ -56,6 +56,10 @@ class IdentificationResult:
     ps_pa : ndarray, shape (N,), or None
         The static source's pressure used (compressible only): sets the flight's pressure
         altitude for the altimeter correction.
+    ps_ref_pa : ndarray, shape (N,), or None
+        The flight's independent reference static pressure, when it had one (compressible):
+        the prediction used it, and it separates static from total pressure error
+        (`estimation.static_source`).
     """
 
     model: str
@@ -82,6 +86,7 @@ class IdentificationResult:
     timing_s: dict = field(default_factory=dict)
     air_data: str = "incompressible"
     ps_pa: np.ndarray | None = None
+    ps_ref_pa: np.ndarray | None = None
 
     # --- derived quantities -------------------------------------------------------------
     @property

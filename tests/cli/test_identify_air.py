@@ -21,12 +21,17 @@ def compressible_csv(tmp_path_factory):
     return write_flight_csv(flight, tmp_path_factory.mktemp("air") / "flight.csv"), flight, truth
 
 
-def test_flight_csv_round_trip_keeps_the_static_columns(compressible_csv):
+def test_flight_csv_round_trip_keeps_the_static_columns(compressible_csv, tmp_path):
+    import dataclasses
+
     path, flight, _ = compressible_csv
     got = read_flight(path)
     for name in ("ps_pa", "oat_k", "rho_kgm3"):
-        assert got.__getattribute__(name) == pytest.approx(getattr(flight, name), rel=1e-8)
+        assert getattr(got, name) == pytest.approx(getattr(flight, name), rel=1e-8)
     assert got.ps_ref_pa is None
+    with_ref = dataclasses.replace(flight, ps_ref_pa=flight.ps_pa - 50.0)
+    again = read_flight(write_flight_csv(with_ref, tmp_path / "ref.csv"))
+    assert again.ps_ref_pa == pytest.approx(with_ref.ps_ref_pa, rel=1e-8)
 
 
 @pytest.mark.parametrize("air", ["compressible", "incompressible", None])

@@ -210,6 +210,11 @@ def test_qc_from_total_pressure_is_the_isentropic_relation():
     np.testing.assert_allclose(d1, (up - dn) / (2 * h), rtol=1e-7)
     up, dn = (ad.qc_from_total_derivatives(tas ** 2 + s, ps + qc, oat)[0] for s in (h, -h))
     np.testing.assert_allclose(d2, (up - dn) / (2 * h), rtol=1e-6)
+    s1, s2 = ad.qc_from_tas_sq_derivatives(tas ** 2, ps, oat)      # at fixed p_s instead
+    up, dn = (ad.qc_from_tas_sq_pa(tas ** 2 + s, ps, oat) for s in (h, -h))
+    np.testing.assert_allclose(s1, (up - dn) / (2 * h), rtol=1e-7)
+    up, dn = (ad.qc_from_tas_sq_derivatives(tas ** 2 + s, ps, oat)[0] for s in (h, -h))
+    np.testing.assert_allclose(s2, (up - dn) / (2 * h), rtol=1e-6)
     # the low-speed limit is the paper's eq. 2 with rho = p_T / (R T_s), less 0.9 M^2
     mach = ad.mach_from_tas(tas[0], oat[0])
     rho_t = (ps[0] + qc[0]) / (units.R_AIR_JKGK * oat[0])

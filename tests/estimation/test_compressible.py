@@ -140,3 +140,47 @@ def test_coverage_of_the_2_sigma_bands_in_turbulence():
         inside["dh"] += [abs(row["dh_ft"] - t) <= row["dh_2sigma_ft"] for row, t in zip(rows, true_dh)]
     coverage = {name: float(np.mean(v)) for name, v in inside.items()}
     assert all(0.85 <= c <= 1.0 for c in coverage.values()), coverage
+
+
+@pytest.fixture(scope="module")
+def split_flight():
+    """A compressible flight whose pressure error is 60 % static, 40 % total, with a reference
+    static pressure: the static port reads p_s + 0.6 Δp, the pitot p_T − 0.4 Δp (q_ci as before)."""
+    cas, alt, radius = RANGES["90-150 kt, 8,000 ft"]
+    plan = circle_plan(duration_s=240.0, cas_kt=cas, radius_m=radius, altitude_m=alt,
+                       wind_speed_mps=5.0)
+    flight, truth = simulate(plan, seed=0, turbulence_mps=0.0, rate_hz=10.0,
+                             air_data="compressible", keep_history=True)
+    ps = units.isa_pressure_pa(truth.history["alt_m"])
+    split = dataclasses.replace(flight, ps_pa=ps + 0.6 * (flight.ps_pa - ps))
+    return split, dataclasses.replace(split, ps_ref_pa=ps), truth
+
+
+def test_reference_static_pressure_separates_static_and_total_error(split_flight):
+    assumed, measured, truth = split_flight
+    result = identify(measured, model="inverse")
+    assert result.air_data == "compressible" and result.ps_ref_pa is not None
+    for name in ("k1", "k2"):                      # the total error, from the reference p_s
+        assert abs(result.value(name) - truth.parameters[name]) < 3 * result.stddev(name)
+    d = result.to_dict()
+    assert d["static_source"]["assumed"].startswith("static-source error measured against")
+    k_static = d["static_source"]["k_static"]
+    assert k_static["k1"]["value"] == pytest.approx(0.6 * 0.02, rel=2e-3)
+    assert k_static["k2"]["value"] == pytest.approx(0.6 * -15.0, rel=2e-3)
+    rows = d["airspeed_correction"]
+    vi = np.array([row["vi_kt"] for row in rows])
+    model = get_model(truth.model)
+    qci = ad.qc_from_cas_pa(units.kt_to_mps(vi))
+    dp_total = qc_from_qci_pa(model, truth.k, qci) - qci
+    dpt = np.array([row["dpt_qcic"] for row in rows])
+    band = np.array([row["dpt_qcic_2sigma"] for row in rows])
+    assert np.all(np.abs(dpt - (-0.4 * dp_total / qci)) < 1.5 * band + 1e-5)
+    # ΔH_pc from the static part only: 0.6 of the all-static value
+    ps_ind = float(np.median(measured.ps_pa))
+    dh_true = units.m_to_ft(ad.pressure_altitude_m(ps_ind - 0.6 * dp_total)
+                            - ad.pressure_altitude_m(ps_ind))
+    np.testing.assert_allclose([row["dh_ft"] for row in rows], dh_true, rtol=0.01)
+    assert "Measured: static-source error measured against" in result.summary()
+    # without the reference the all-static assumption is wrong here, and k1 shows it
+    wrong = identify(assumed, model="inverse")
+    assert abs(wrong.value("k1") - 0.02) > 3 * wrong.stddev("k1")

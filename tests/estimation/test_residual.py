@@ -87,17 +87,22 @@ def _air(d, seed=4):
     return rng.uniform(60000.0, 100000.0, n), rng.uniform(250.0, 290.0, n)
 
 
+@pytest.mark.parametrize("kind", ["compressible", "reference"])
 @pytest.mark.parametrize("name", ["constant", "inverse"])
-def test_compressible_residual_casadi_numpy_and_jacobian(name):
-    """The compressible residual: CasADi graph = numpy lines; the closed-form sensitivities
-    (local slope a) = CasADi's Jacobian; the objective's spread term uses the same a."""
+def test_compressible_residual_casadi_numpy_and_jacobian(name, kind):
+    """The compressible residual (total pressure, or a reference static pressure): CasADi
+    graph = numpy lines; the closed-form sensitivities (local slope a) = CasADi's Jacobian."""
+    from pitotcal.estimation.residual import AIR_CHANNELS, ReferenceAir, TotalAir
+
     model, n = get_model(name), 30
     d = _data(n, True, seed=5)
     pt, oat = _air(d)
+    air = TotalAir(pt, oat) if kind == "compressible" else ReferenceAir(0.95 * pt, oat)
     theta = np.array([0.02, -15.0][: len(model.params)] + [3.0, -4.0])
-    fn = residual_function(model, n, True, "compressible")
-    assert fn.name_in() == ["theta", "qci", "vn", "ve", "pt", "oat", "vd2", "c_eiv"]
-    args = (d["qci"], d["vn"], d["ve"], (pt, oat), d["vd2"], d["c_eiv"])
+    fn = residual_function(model, n, True, kind)
+    assert fn.name_in() == ["theta", "qci", "vn", "ve", *AIR_CHANNELS[kind], "vd2", "c_eiv"]
+    args = (d["qci"], d["vn"], d["ve"], air, d["vd2"], d["c_eiv"])
+    pt = air[0]
     want = residual_terms(model, theta, *args)
     got = fn(theta, d["qci"], d["vn"], d["ve"], pt, oat, d["vd2"], d["c_eiv"])
     for g, w in zip(got, want):

@@ -51,6 +51,7 @@ __all__ = [
     "qc_from_cas_pa",
     "qc_from_mach_pa",
     "qc_from_tas_pa",
+    "qc_from_tas_sq_derivatives",
     "qc_from_tas_sq_pa",
     "qc_from_total_derivatives",
     "qc_from_total_pa",
@@ -133,6 +134,21 @@ def qc_from_tas_sq_pa(tas_sq, ps_pa, oat_k, lib=np):
     if _numeric(lib):
         _refuse_outside("mach", np.sqrt(np.abs(mach_sq)), 0.0, 1.0, "the subsonic range")
     return ps_pa * ((1.0 + 0.2 * mach_sq) ** 3.5 - 1.0)
+
+
+def qc_from_tas_sq_derivatives(tas_sq, ps_pa, oat_k, lib=np):
+    """(dq_c/dV_t², d²q_c/d(V_t²)²) of `qc_from_tas_sq_pa` at fixed p_s and T_s.
+
+    Notes
+    -----
+    With c = 0.2 / (γ R T_s): dq_c/dV_t² = 3.5 c p_s (1 + c V_t²)^2.5 (→ ½ρ as M → 0) and
+    d²q_c/d(V_t²)² = 2.5 c (dq_c/dV_t²) / (1 + c V_t²).
+    """
+    tas_sq, ps_pa, oat_k = _floats(lib, tas_sq, ps_pa, oat_k)
+    c = 0.2 / (GAMMA * R_AIR_JKGK * oat_k)
+    base = 1.0 + c * tas_sq
+    slope = 3.5 * c * ps_pa * base ** 2.5
+    return slope, 2.5 * c * slope / base
 
 
 def qc_from_total_pa(tas_sq, pt_pa, oat_k, lib=np):
