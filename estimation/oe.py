@@ -164,6 +164,11 @@ class OutputErrorProblem:
         a_i = (1 - f(q_ci,i; k)) rho_i / 2,
 
     whose expectation over the GPS noise is the noise-free sum of squares plus a constant.
+    That is the incompressible problem (paper eq. 2). The compressible one replaces
+    rho/2 (V_t^2 - n sigma_v^2) by the isentropic q_c(V_t^2 - n sigma_v^2) of the measured total
+    pressure (or a reference static pressure) and a_i by the local slope
+    (1 - f) dq_c/dV_t^2 (`estimation.residual`); the curvature of q_c(V_t^2) leaves a bias
+    of about M^2/2 of the noise correction itself, negligible.
     w scales J to O(1) at the start. IPOPT uses the exact Hessian.
 
     Example
