@@ -192,6 +192,9 @@ def _check_flight(flight, air_data="incompressible"):
         bad = ~np.isfinite(values)
         if bad.any():
             raise FlightDataError(f"{flight.source}: {name}, row {int(np.argmax(bad)) + 1}: not finite")
+        if name in air and np.any(values <= 0):
+            raise FlightDataError(f"{flight.source}: {name}, row "
+                                  f"{int(np.argmax(values <= 0)) + 1}: not positive")
 
 
 def track_spread_deg(vn_mps, ve_mps):

@@ -184,3 +184,29 @@ def test_reference_static_pressure_separates_static_and_total_error(split_flight
     # without the reference the all-static assumption is wrong here, and k1 shows it
     wrong = identify(assumed, model="inverse")
     assert abs(wrong.value("k1") - 0.02) > 3 * wrong.stddev("k1")
+
+
+@pytest.mark.parametrize("column, value, match", [
+    ("oat_k", np.nan, "oat_k, row 5: not finite"),
+    ("oat_k", -3.0, "oat_k, row 5: not positive"),
+    ("ps_pa", 0.0, "ps_pa, row 5: not positive"),
+])
+def test_bad_static_channels_are_refused(flown, column, value, match):
+    from pitotcal.core.errors import FlightDataError
+
+    _, flight, _, _ = flown
+    values = getattr(flight, column).copy()
+    values[4] = value
+    with pytest.raises(FlightDataError, match=match):
+        identify(dataclasses.replace(flight, **{column: values}))
+    # the incompressible fit does not use them
+    identify(dataclasses.replace(flight, **{column: values}), air="incompressible")
+
+
+def test_unknown_air_mode_is_refused(flown):
+    from pitotcal.core.errors import PitotcalError
+
+    with pytest.raises(PitotcalError, match="air 'isentropic' is not one of incompressible, "
+                                            "compressible") as err:
+        identify(flown[1], air="isentropic")
+    assert err.value.param == "air"
