@@ -28,8 +28,9 @@ def add_parser(subparsers):
     p.add_argument("--air", default="compressible", metavar="MODE",
                    help="how impact pressure follows from true airspeed: compressible "
                         "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
-                        "all pressure error taken in the static source; V_i, V_c standard "
-                        "CAS) or incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
+                        "all pressure error taken in the static source, or separated with "
+                        "a ps_ref_pa reference column; V_i, V_c standard CAS) or "
+                        "incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
                         "paper's eq. 2 and the results before issue 9); a flight without "
                         "ps_pa/oat_k is fitted incompressible with a warning; default "
                         "%(default)s")
