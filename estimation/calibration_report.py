@@ -247,15 +247,17 @@ def _mach_rows(result):
     if result.get("air_data") == "compressible":
         from pitotcal.core.airdata import qc_from_cas_pa
     else:
-        from pitotcal.core.units import qc_from_cas_pa
+        from pitotcal.core.units import incompressible_qc_pa as qc_from_cas_pa
     from pitotcal.core.units import kt_to_mps
 
     out = []
     for r in rows:
-        qci = float(qc_from_cas_pa(kt_to_mps(r["vi_kt"])))
-        qc = float(qc_from_cas_pa(kt_to_mps(r["vc_kt"])))
-        out.append({"mach": r["mach_i"], "dmach": r.get("dmach"),
-                    "ratio": (qc - qci) / qci, "vi": r["vi_kt"]})
+        ratio = r.get("dpp_qcic")       # the identification's own Δp_p/q_cic, when it gave it
+        if ratio is None:
+            qci = float(qc_from_cas_pa(kt_to_mps(r["vi_kt"])))
+            ratio = (float(qc_from_cas_pa(kt_to_mps(r["vc_kt"]))) - qci) / qci
+        out.append({"mach": r["mach_i"], "dmach": r.get("dmach"), "ratio": ratio,
+                    "vi": r["vi_kt"]})
     return out
 
 

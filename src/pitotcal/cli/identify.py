@@ -10,6 +10,7 @@ after the summary; the JSON and figure are written first).
 from pathlib import Path
 
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
+AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_DATA_MODES
 
 
 def add_parser(subparsers):
@@ -25,6 +26,16 @@ def add_parser(subparsers):
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
+    # --- air data (issue 9) ---
+    p.add_argument("--air", default="compressible", metavar="MODE",
+                   help="how impact pressure follows from true airspeed: compressible "
+                        "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
+                        "all pressure error taken in the static source, or separated with "
+                        "a ps_ref_pa reference column; V_i, V_c standard CAS) or "
+                        "incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
+                        "paper's eq. 2 and the results before issue 9); a flight without "
+                        "ps_pa/oat_k is fitted incompressible with a warning; default "
+                        "%(default)s")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
@@ -60,6 +71,7 @@ def run(args):
     from pitotcal.io import is_log_file, read_flight
 
     choice("model", args.model, [*MODELS, "auto"])
+    choice("air", args.air, AIR_CHOICES)
     if args.gps_noise_mps is not None:
         number("gps_noise_mps", args.gps_noise_mps, 0.0, 10.0, hi_open=True)
     source = Path(args.flight)
@@ -81,7 +93,8 @@ def run(args):
             from pitotcal.core.errors import PitotcalError
             raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
                                 "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
-    result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
+    result = identify(flight, model=args.model, air=args.air,
+                      gps_noise_std_mps=args.gps_noise_mps)
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
@@ -110,7 +123,7 @@ def _write_params(args, flight, autopilot, current):
     name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
         if autopilot == "PX4" else None
     rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
-                    gps_noise_std_mps=args.gps_noise_mps, name=name)
+                    gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air)
     write_parameter_file(rec, args.params)
     print(f"\nRecommended {rec.name} = {rec.value:.4f} ± {rec.two_sigma:.4f} (2σ)"
           + ("" if rec.current is None else f", now {rec.current:.6g}")

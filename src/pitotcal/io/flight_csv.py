@@ -80,7 +80,7 @@ def write_flight_csv(flight, path, comments=None):
     """
     columns = ["time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3"]
     data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
-    for name in ("gps_vd_mps", "alt_m"):
+    for name in ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa"):
         if getattr(flight, name) is not None:
             columns.append(name)
             data.append(getattr(flight, name))
@@ -94,7 +94,10 @@ def write_flight_csv(flight, path, comments=None):
 # --- reading and validation -------------------------------------------------------------
 
 REQUIRED_COLUMNS = ("time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps")
-OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m")
+OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_ref_pa")
+# Static pressure (the static source's reading) and temperature: density when rho_kgm3 is
+# absent, and the compressible calibration's air data whenever both are present.
+STATIC_COLUMNS = ("ps_pa", "oat_k")
 MIN_ROWS = 10
 
 
@@ -133,16 +136,18 @@ def read_flight_csv(path, start_s=None, end_s=None):
 
     qci = data[:, col["qc_pa"]]
     vn, ve = data[:, col["gps_vn_mps"]], data[:, col["gps_ve_mps"]]
+    if "ps_pa" in col and "oat_k" in col:
+        check_ps_oat(name, data[:, col["ps_pa"]], data[:, col["oat_k"]])
     if "rho_kgm3" in col:
         rho = data[:, col["rho_kgm3"]]
         check_rho(name, rho)
     else:
-        ps, oat = data[:, col["ps_pa"]], data[:, col["oat_k"]]
-        check_ps_oat(name, ps, oat)
-        rho = density_kgm3(ps, oat)
+        rho = density_kgm3(data[:, col["ps_pa"]], data[:, col["oat_k"]])
     check_units(name, qci, vn, ve, rho)
+    if "ps_ref_pa" in col:
+        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, 288.15), column="ps_ref_pa")
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
-                for c in OPTIONAL_COLUMNS}
+                for c in (*OPTIONAL_COLUMNS, *STATIC_COLUMNS)}
     return Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
                   gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
                   rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
@@ -266,10 +271,11 @@ def _used_columns(name, columns):
         raise FlightDataError(f"{name}: missing column{'s' if len(missing) > 1 else ''} "
                               f"{', '.join(hints)}; required: {', '.join(REQUIRED_COLUMNS)} "
                               "and density (rho_kgm3, or both ps_pa and oat_k)")
+    static = ["ps_pa", "oat_k"] if {"ps_pa", "oat_k"} <= present else []
     if "rho_kgm3" in present:
-        density = ["rho_kgm3"]
-    elif "ps_pa" in present and "oat_k" in present:
-        density = ["ps_pa", "oat_k"]
+        density = ["rho_kgm3"] + static
+    elif static:
+        density = static
     else:
         found = [c for c in ("ps_pa", "oat_k") if c in present]
         also = f" (found only {found[0]})" if found else ""
