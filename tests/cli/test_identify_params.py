@@ -44,7 +44,9 @@ def test_px4_ulog_end_to_end_qgc_file(flight, tmp_path, capsys):
 
     log, out = tmp_path / "f.ulg", tmp_path / "new.params"
     write_ulog(log, flight)
-    assert main(["identify", str(log), "--model", "constant", "--params", str(out)]) == 0
+    # the synthetic flight's truth is q_c = ½ρV² (incompressible): fitted as it was made
+    assert main(["identify", str(log), "--model", "constant", "--air", "incompressible",
+                 "--params", str(out)]) == 0
     params = read_qgc_params(out)
     assert list(params) == ["ASPD_SCALE"]
     assert params["ASPD_SCALE"] == pytest.approx(1.0 / 0.82 ** 0.5, rel=2e-3)
@@ -57,7 +59,9 @@ def test_dataflash_end_to_end_mavproxy_file(flight, tmp_path, capsys):
 
     log, out = tmp_path / "f.log", tmp_path / "new.param"
     write_dataflash_text(log, flight, ratio=2.0)
-    assert main(["identify", str(log), "--model", "constant", "--params", str(out)]) == 0
+    # the synthetic flight's truth is q_c = ½ρV² (incompressible): fitted as it was made
+    assert main(["identify", str(log), "--model", "constant", "--air", "incompressible",
+                 "--params", str(out)]) == 0
     loaded = MAVParmDict()
     loaded.load(str(out))
     assert loaded["ARSPD_RATIO"] == pytest.approx(2.0 / (1.225 * 0.82), rel=4e-3)
