@@ -30,6 +30,7 @@ from pathlib import Path
 
 from pitotcal.core.checks import integer
 from pitotcal.core.errors import PitotcalError
+from pitotcal.io.atomic import atomic_open
 
 __all__ = [
     "SERIAL_BELOW",
@@ -276,7 +277,7 @@ def write_table(rows, path, comments=(), columns=()):
     columns = [c for c in columns if c in present]
     for row in rows:
         columns.extend(k for k in row if k not in columns)
-    with open(path, "w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         fh.writelines(f"# {line}\n" for line in comments)
         writer = csv.DictWriter(fh, fieldnames=columns, restval="")
         writer.writeheader()

@@ -9,6 +9,7 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.plan import PLAN_COLUMNS, Plan
+from pitotcal.io.atomic import atomic_open
 
 __all__ = ["read_plan", "write_plan"]
 
@@ -16,7 +17,7 @@ __all__ = ["read_plan", "write_plan"]
 def write_plan(plan, path):
     """Write the plan CSV: `# key: json-value` lines with the settings, then the columns."""
     path = Path(path)
-    with path.open("w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         for key, value in plan.settings.items():
             fh.write(f"# {key}: {json.dumps(value)}\n")
         writer = csv.writer(fh)
