@@ -116,7 +116,7 @@ def not_dask_port():
 
 
 def test_a_port_that_is_not_dask_is_one_line_error_not_a_hang(not_dask_port, monkeypatch):
-    import pitotcal.studies.runner as runner
+    from pitotcal.studies import runner
 
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1.0)
     address = f"tcp://127.0.0.1:{not_dask_port}"
