@@ -120,9 +120,11 @@ def first_seconds(flight, seconds):
 
 
 def truth_delta_v_kt(truth, vi_kt):
-    """The true ΔV (kt) of a simulator `Truth` at indicated `vi_kt`."""
+    """The true ΔV (kt) of a simulator `Truth` at indicated `vi_kt`, by the airspeed law of
+    its air data (the standard CAS law for compressible truth)."""
     model = get_model(truth.model)
-    return delta_v_kt(model, [truth.parameters[p] for p in model.params], vi_kt)
+    return delta_v_kt(model, [truth.parameters[p] for p in model.params], vi_kt,
+                      getattr(truth, "air_data", "incompressible"))
 
 
 def vi_grid_kt(qci_pa, n=N_DV_GRID):
