@@ -15,6 +15,7 @@ Each refusal names the radius (or duration) that works.
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -105,10 +106,16 @@ def _stepped_levels(plan):
     """The plan's own levels; level i lasts from the end of dwell i-1 (the autopilot ramps
     during the loiter that follows a speed change) to the end of dwell i."""
     levels = plan.settings["levels_qc_pa"]
-    ends = []
-    for q in levels[:-1]:
-        at = np.flatnonzero(np.isclose(plan.qc_pa, q, rtol=1e-6, atol=1e-3))
-        ends.append(plan.time_s[at[-1]])
+    ends, start = [], 0
+    for q, following in pairwise(levels):
+        # in flying order (a designed plan may come back to a level): the end of this dwell
+        # is the last node at q before the first node at the next level
+        at = np.isclose(plan.qc_pa, q, rtol=1e-6, atol=1e-3)
+        nxt = start + np.flatnonzero(np.isclose(plan.qc_pa[start:], following, rtol=1e-6,
+                                                atol=1e-3))[0]
+        last = np.flatnonzero(at[:nxt])[-1]
+        ends.append(plan.time_s[last])
+        start = nxt
     bounds = [plan.time_s[0], *ends, plan.time_s[-1]]
     return tuple(float(cas_from_qc_mps(q)) for q in levels), _whole_seconds(bounds), None
 

@@ -137,6 +137,7 @@ def pilot_card_text(plan, cue_s=15.0):
         f"bearing {_bearing_deg(plan, 0):03.0f}°, heading {_heading_cue(plan, 0):03.0f}°, "
         f"{_bank_cue(plan.bank_deg[0])}, {mps_to_kt(plan.cas_mps[0]):.0f} KCAS",
         *(_geo_lines(plan) if geo else []),
+        *_design_lines(s),
         "HDG: heading flown, °true | FROM CTR: distance and bearing from the centre",
         "",
         (f"{'TIME':>5}  {'KCAS':>9}  {'BANK':>5}  {'HDG':>4}  "
@@ -155,6 +156,17 @@ def pilot_card_text(plan, cue_s=15.0):
                      + f"{dist_ft:6.0f} ft {_bearing_deg(plan, k):03.0f}°  "
                      f"{_speed_cue(plan, k, accel, kcas_rate)}")
     return "\n".join(lines) + "\n"
+
+
+def _design_lines(s):
+    """Why an optimal design's speeds are what they are (none for the paper profiles)."""
+    if s.get("design") != "optimal":
+        return []
+    return [(f"Designed for information: dwells {s.get('dwell_order')} (L/C/H: low, check, "
+             f"high), predicted dV 2sigma {s.get('predicted_dv_2sigma_kt')} kt "
+             f"({s.get('criterion')}) in {s.get('turbulence_mps')} m/s turbulence"),
+            (f"Stall {s.get('stall_kt')} KCAS x {s.get('stall_margin')} at the turn's load "
+             f"factor holds the bank to {s.get('bank_max_deg')}°")]
 
 
 def write_pilot_card(plan, png_path=None, txt_path=None, cue_s=15.0):

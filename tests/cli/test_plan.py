@@ -184,3 +184,32 @@ def test_export_refuses_the_downwind_bank(tmp_path, capsys):
         "57.1 m/s ground speed (101 KTAS in 5 m/s wind) banks 31°, over --bank-max-deg 30°: "
         "export a plan with --radius-m at least 575 m\n")
     assert list(tmp_path.iterdir()) == []
+
+
+# --- plan --design optimal (issue 13) --------------------------------------------------------
+
+@pytest.mark.parametrize("argv, message", [
+    (["--stall-kt", "50"], "--stall-kt is for --design optimal"),
+    (["--design", "optimal", "--stall-kt", "62"],
+     "--stall-kt 62 KCAS leaves --cas-min-kt 70 below 1.2 x the stall speed at 5° bank"),
+    (["--design", "optimal", "--turbulence-mps", "0"], "--turbulence-mps 0 must be > 0"),
+    (["--design", "optimal", "--check-fraction", "0.7"], "--check-fraction 0.7 must be"),
+])
+def test_design_refusals_exit_2_naming_the_flag(argv, message, tmp_path, capsys):
+    out = tmp_path / "plan.csv"
+    assert main(["plan", *argv, "--no-figures", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pitotcal plan: ") and message in err, err
+    assert not out.exists()
+
+
+def test_design_optimal_card_and_csv_say_why(tmp_path, capsys):
+    out = tmp_path / "opt.csv"
+    assert main(["plan", "--design", "optimal", "--check-fraction", "0", "--no-figures",
+                 "-o", str(out)]) == 0
+    plan = read_plan(out)
+    s = plan.settings
+    assert s["design"] == "optimal" and s["check_fraction"] == 0.0
+    assert len(set(s["levels_qc_pa"])) == 2 and s["predicted_dv_2sigma_kt"] < 1.0
+    card = (tmp_path / "opt.card.txt").read_text()
+    assert "Designed for information" in card and "predicted dV 2sigma" in card

@@ -50,6 +50,7 @@ def add_parser(subparsers):
                         "(default: msl, the altitude whose ISA density gives the TAS)")
     p.add_argument("--magvar-deg", type=float, default=None, metavar="DEG",
                    help="magnetic variation, east positive: the card adds magnetic headings")
+    _add_design_arguments(p)
     p.add_argument("-o", "--output", required=True, metavar="PLAN.csv", help="plan CSV to write")
     p.set_defaults(run=run)
 
@@ -68,7 +69,7 @@ def run(args):
         args.duration_s, args.bank_max_deg, args.wind_speed_mps, args.wind_from_deg,
         roll_rate_max_dps=args.roll_rate_max_dps, accel_max_mps2=args.accel_max_mps2,
         levels=args.levels, return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s,
-        max_iter=max_iter)
+        max_iter=max_iter, design=args.design, design_options=_design_options(args))
     check_converged(plan, max_iter)
     if geo:
         plan = dataclasses.replace(plan, settings={**plan.settings, **geo})
@@ -133,3 +134,46 @@ def _geo_settings(args):
     if magvar is not None:
         geo["magvar_deg"] = magvar
     return geo
+
+
+_DESIGN_FLAGS = {"turbulence_mps": "--turbulence-mps", "criterion": "--criterion",
+                 "target_2sigma_kt": "--target-2sigma-kt", "stall_kt": "--stall-kt",
+                 "stall_margin": "--stall-margin", "check_fraction": "--check-fraction"}
+
+
+def _add_design_arguments(p):
+    p.add_argument("--design", choices=("paper", "optimal"), default="paper",
+                   help="paper: --profile's schedule; optimal: the speed schedule that "
+                        "minimises the predicted 2σ of ΔV in turbulence (default: paper)")
+    g = p.add_argument_group("optimal design (with --design optimal)")
+    g.add_argument("--turbulence-mps", type=float, default=None, metavar="M/S",
+                   help="RMS gust the design is for (default: 0.5)")
+    g.add_argument("--criterion", choices=("worst", "average"), default=None,
+                   help="minimise the worst or the mean 2σ of ΔV over the range "
+                        "(default: worst)")
+    g.add_argument("--target-2sigma-kt", type=float, default=None, metavar="KT",
+                   help="plan the shortest flight whose predicted 2σ of ΔV meets this "
+                        "(replaces --duration-s)")
+    g.add_argument("--stall-kt", type=float, default=None, metavar="KCAS",
+                   help="stall speed (default: --cas-min-kt / 1.3)")
+    g.add_argument("--stall-margin", type=float, default=None, metavar="X",
+                   help="cas-min must be X times the stall speed at the turn's load factor; "
+                        "limits the bank (default: 1.2)")
+    g.add_argument("--check-fraction", type=float, default=None, metavar="F",
+                   help="dwell share of the middle speed that checks the model structure "
+                        "(default: 0.1; 0: two speeds only)")
+
+
+def _design_options(args):
+    """The design flags as `design_options` (None with the paper design; a design flag
+    without --design optimal is an error, not silently ignored)."""
+    given = {name: getattr(args, name) for name in _DESIGN_FLAGS
+             if getattr(args, name) is not None}
+    if args.design != "optimal":
+        if given:
+            from pitotcal.core.errors import PitotcalError
+
+            flag = _DESIGN_FLAGS[next(iter(given))]
+            raise PitotcalError(f"{flag} is for --design optimal")
+        return None
+    return given
