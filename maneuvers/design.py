@@ -367,3 +367,20 @@ def record_prediction(settings, schedule, sol, req, options):
                             wind_vector_mps(req.wind_speed_mps, req.wind_from_deg), noise, vi_kt)
     return {**settings, "predicted_dv_2sigma_kt": round(_criterion(bands, options.criterion), 3),
             "turbulence_tau_s": round(noise.tau_s, 2)}
+
+
+def predict_plan_band_kt(plan, turbulence_mps, vi_kt, *, model="inverse", k=None):
+    """(reported, actual) 2σ of ΔV at `vi_kt` predicted for a planned flight (any profile or
+    design) in `turbulence_mps` of Dryden turbulence; see `predict_band_kt`."""
+    from types import SimpleNamespace
+
+    from pitotcal.core.units import isa_density_kgm3, wind_vector_mps
+
+    s = plan.settings
+    alt = float(np.mean(plan.alt_m))
+    track = SimpleNamespace(time_s=plan.time_s, tas_mps=plan.tas_mps,
+                            rho_kgm3=float(isa_density_kgm3(alt)))
+    wind = wind_vector_mps(s.get("wind_speed_mps", 0.0), s.get("wind_from_deg", 0.0))
+    return predict_band_kt(track, np.radians(plan.heading_deg), wind,
+                           default_noise(turbulence_mps, alt, plan.tas_mps), vi_kt,
+                           model=model, k=k)

@@ -219,6 +219,11 @@ def check_loiter(plan):
     the highest ground speed, downwind at the fastest airspeed.
     """
     s = plan.settings
+    if s.get("turn") == "both":
+        raise PlanInfeasibleError(
+            "turn both cannot be exported: the mission is one loiter circle at the centre, "
+            "flown one way (ArduPilot and PX4 take the direction per loiter item, not within "
+            "one); export a plan with turn right or left", param="turn")
     radius, wind = float(s["radius_m"]), float(s["wind_speed_mps"])
     bank_max = float(s["bank_max_deg"])
     vg_max = float(np.max(plan.tas_mps)) + wind
@@ -234,7 +239,8 @@ def check_loiter(plan):
     wind_ne = tuple(float(w) for w in wind_vector_mps(wind, s["wind_from_deg"]))
     turn = min(_heading_turns_rad(plan, radius, wind_ne))
     if turn < 2 * np.pi:
-        where = "dwell" if len(s.get("levels_qc_pa") or ()) == 2 else "third of the q range"
+        # two coverage groups: two-speed's dwells or a designed plan's end levels
+        where = "dwell" if len(s.get("coverage_runs") or ()) == 2 else "third of the q range"
         fits = _coverage_radius_m(plan, radius, wind_ne)
         head = (f"a {radius:g} m loiter circle turns only {math.degrees(turn):.0f}° of heading "
                 f"in one {where}")

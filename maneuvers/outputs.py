@@ -131,7 +131,7 @@ def pilot_card_text(plan, cue_s=15.0):
         f"Altitude {alt_ft:.0f} ft{alt_ref} +-{ALT_TOLERANCE_FT:.0f} ft | airspeed target "
         f"+-{CAS_TOLERANCE_KT:.0f} KCAS | "
         f"stay within {m_to_ft(s.get('radius_m', np.nan)):.0f} ft of centre",
-        f"Turns {s.get('turn', 'right')}, bank max {s.get('bank_max_deg', '?')}° | "
+        f"{_turn_text(s)}, bank max {s.get('bank_max_deg', '?')}° | "
         f"expected wind {wind}",
         f"Start {m_to_ft(np.hypot(plan.north_m[0], plan.east_m[0])):.0f} ft from centre on "
         f"bearing {_bearing_deg(plan, 0):03.0f}°, heading {_heading_cue(plan, 0):03.0f}°, "
@@ -156,6 +156,14 @@ def pilot_card_text(plan, cue_s=15.0):
                      + f"{dist_ft:6.0f} ft {_bearing_deg(plan, k):03.0f}°  "
                      f"{_speed_cue(plan, k, accel, kcas_rate)}")
     return "\n".join(lines) + "\n"
+
+
+def _turn_text(s):
+    turn = s.get("turn", "right")
+    if turn != "both":
+        return f"Turns {turn}"
+    # why: a term that goes with the turn rate (a probe's lever arm) cancels over the flight
+    return "Turns alternate R/L by speed group (lever-arm term averages out)"
 
 
 def _design_lines(s):

@@ -18,13 +18,13 @@ from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
-from pitotcal.maneuvers.ocp import ManeuverProblem, PathSolution, turn_radius_m
+from pitotcal.maneuvers.ocp import TURNS, ManeuverProblem, PathSolution, turn_radius_m
 from pitotcal.maneuvers.profiles import make_schedule
 
 from pitotcal.core.checks import integer, number, option_dict, positive
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
-from pitotcal.core.plan import PROFILES, TURNS, Plan
+from pitotcal.core.plan import PROFILES, Plan
 from pitotcal.core.scenario import T2_PLAN
 from pitotcal.core.units import G0_MPS2, RHO0_KGM3, kt_to_mps, mps_to_kt, wind_vector_mps
 
@@ -347,8 +347,8 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         Step-pause levels, equally spaced in q.
     return_leg : bool
         Continuous profile: sweep back down to cas_min in the second half.
-    turn : {"right", "left"}
-        Turn direction.
+    turn : {"right", "left", "both"}
+        Turn direction; "both" alternates from one coverage group to the next.
     dt_s : float
         Node spacing of the plan, s.
     margin_m : float

@@ -70,3 +70,20 @@ def test_bad_design_options_are_refused():
         plan_maneuver(design="optimal", design_options={"criterion": "D"})
     with pytest.raises(PitotcalError, match="turbulence"):
         plan_maneuver(design="optimal", design_options={"turbulence": 1.0})
+
+
+def test_turn_both_alternates_orbits_and_is_not_exported():
+    from pitotcal.maneuvers.missions import check_loiter
+    from pitotcal.maneuvers.ocp import group_signs
+
+    plan = plan_maneuver(profile="continuous", return_leg=True, turn="both")
+    assert plan.success
+    runs = plan.settings["coverage_runs"]
+    turns = [sum(plan.heading_deg[b] - plan.heading_deg[a] for a, b in g) for g in runs]
+    # thirds of the q range in the order flown: right, left, right, each a full orbit
+    assert turns[0] >= 375 - 1e-3 and turns[1] <= -375 + 1e-3 and turns[2] >= 375 - 1e-3
+    assert plan.bank_deg.max() > 5 and plan.bank_deg.min() < -5
+    assert np.hypot(plan.north_m, plan.east_m).max() <= 926.0
+    assert list(group_signs(((( 50, 60),), ((0, 10),), ((20, 30),)), "both")) == [1, 1, -1]
+    with pytest.raises(PlanInfeasibleError, match="turn both cannot be exported"):
+        check_loiter(plan)

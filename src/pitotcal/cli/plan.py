@@ -32,8 +32,10 @@ def add_parser(subparsers):
     p.add_argument("--levels", type=int, default=4, help="step-pause levels (default: 4)")
     p.add_argument("--return", dest="return_leg", action="store_true",
                    help="continuous profile: sweep back down to --cas-min-kt")
-    p.add_argument("--turn", choices=TURNS, default=TURNS[0],
-                   help="turn direction (default: %(default)s)")
+    p.add_argument("--turn", choices=(*TURNS, "both"), default=TURNS[0],
+                   help="turn direction; both: right and left orbits alternate from one "
+                        "speed group to the next, so a probe lever-arm term averages out "
+                        "(default: %(default)s)")
     p.add_argument("--dt-s", type=float, default=1.0, help="plan node spacing (default: 1 s)")
     p.add_argument("--max-iter", type=int, default=None, metavar="N",
                    help="IPOPT iteration limit (default: 300)")
