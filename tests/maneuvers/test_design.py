@@ -87,3 +87,28 @@ def test_turn_both_alternates_orbits_and_is_not_exported():
     assert list(group_signs(((( 50, 60),), ((0, 10),), ((20, 30),)), "both")) == [1, 1, -1]
     with pytest.raises(PlanInfeasibleError, match="turn both cannot be exported"):
         check_loiter(plan)
+
+
+def test_mission_levels_of_a_designed_schedule_in_flying_order():
+    """A level that comes back (L-C-H-L-H) is a new speed item; the loiter times add up."""
+    from pitotcal.maneuvers.missions import speed_levels
+    from pitotcal.maneuvers.profiles import dwell_schedule
+
+    from pitotcal.core.plan import Plan
+    from pitotcal.core.units import cas_from_qc_mps
+
+    q = [794.29, 1207.645, 1621.0, 794.29, 1621.0]
+    s = dwell_schedule(q, [0.3, 0.1, 0.2, 0.2, 0.2], 300.0, altitude_m=244.0)
+    zeros = np.zeros(s.time_s.size)
+    plan = Plan(s.time_s, zeros, zeros, zeros + 244.0, zeros, zeros, s.tas_mps, s.cas_mps,
+                s.qc_pa, settings={"levels_qc_pa": q})
+    cas, loiter_s, stair = speed_levels(plan)
+    np.testing.assert_allclose(cas, cas_from_qc_mps(np.array(q)))
+    assert sum(loiter_s) == 300 and stair is None
+    # the first dwell (low) lasts 0.3 of the dwell time; each ramp belongs to the level after
+    assert loiter_s[0] == round(0.3 * (300.0 - _ramp_time(s)))
+
+
+def _ramp_time(schedule):
+    accel = np.abs(np.diff(schedule.tas_mps)) > 1e-9
+    return float(np.sum(np.diff(schedule.time_s)[accel]))
