@@ -213,3 +213,31 @@ def test_design_optimal_card_and_csv_say_why(tmp_path, capsys):
     assert len(set(s["levels_qc_pa"])) == 2 and s["predicted_dv_2sigma_kt"] < 1.0
     card = (tmp_path / "opt.card.txt").read_text()
     assert "Designed for information" in card and "predicted dV 2sigma" in card
+
+
+def test_calibration_gives_kias_targets_that_the_correction_maps_back(tmp_path):
+    """--calibration: the card's KIAS at each KCAS target is V_i with V_i + ΔV(V_i) = KCAS."""
+    import json
+
+    from pitotcal.core.models import delta_v_kt, get_model
+
+    result = {"model": "inverse", "parameters": {"k1": {"value": 0.02}, "k2": {"value": -15.0},
+                                                  "wind_speed_mps": {"value": 5.0}}}
+    (tmp_path / "r.json").write_text(json.dumps(result))
+    out = tmp_path / "p.csv"
+    assert main(["plan", "--profile", "two-speed", "--calibration", str(tmp_path / "r.json"),
+                 "--no-figures", "-o", str(out)]) == 0
+    card = (tmp_path / "p.card.txt").read_text().splitlines()
+    assert card[4].endswith("BANK: within 5° of the cue") and card[5].startswith("KIAS: the indicator's reading")
+    head = card.index(next(line for line in card if line.split()[:3] == ["TIME", "KCAS",
+                                                                            "KIAS"]))
+    rows = [line.split() for line in card[head + 1:] if line.strip()]
+    kcas = np.array([float(r[1].split("±")[0]) for r in rows])
+    kias = np.array([float(r[2]) for r in rows])
+    back = kias + delta_v_kt(get_model("inverse"), (0.02, -15.0), kias)
+    np.testing.assert_allclose(back, kcas, atol=0.051)      # one decimal on the card
+    # dp/qc = 0.02 - 15/q_ci > 0 at 100 KCAS: the indicator reads low there (ΔV +0.5 kt)
+    assert kias[-1] < kcas[-1] - 0.3
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    assert main(["plan", "--calibration", str(bad), "--no-figures", "-o", str(out)]) == 2

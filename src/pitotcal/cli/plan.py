@@ -53,6 +53,9 @@ def add_parser(subparsers):
     p.add_argument("--magvar-deg", type=float, default=None, metavar="DEG",
                    help="magnetic variation, east positive: the card adds magnetic headings")
     _add_design_arguments(p)
+    p.add_argument("--calibration", default=None, metavar="RESULT.json",
+                   help="a prior `identify --json` result: the card adds the KIAS the "
+                        "uncalibrated indicator shows at each KCAS target")
     p.add_argument("-o", "--output", required=True, metavar="PLAN.csv", help="plan CSV to write")
     p.set_defaults(run=run)
 
@@ -66,6 +69,7 @@ def run(args):
     max_iter = MAX_ITER if args.max_iter is None else args.max_iter
     check_output_paths(args.output, figures=figures)
     geo = _geo_settings(args)
+    calibration = _calibration(args.calibration)
     plan = plan_maneuver(
         args.profile, args.cas_min_kt, args.cas_max_kt, args.radius_m, args.altitude_m,
         args.duration_s, args.bank_max_deg, args.wind_speed_mps, args.wind_from_deg,
@@ -73,8 +77,8 @@ def run(args):
         levels=args.levels, return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s,
         max_iter=max_iter, design=args.design, design_options=_design_options(args))
     check_converged(plan, max_iter)
-    if geo:
-        plan = dataclasses.replace(plan, settings={**plan.settings, **geo})
+    if geo or calibration:
+        plan = dataclasses.replace(plan, settings={**plan.settings, **geo, **calibration})
     mission = None
     if args.export:
         # refused (the loiter's bank or heading coverage) before any file is written
@@ -179,3 +183,28 @@ def _design_options(args):
             raise PitotcalError(f"{flag} is for --design optimal")
         return None
     return given
+
+
+def _calibration(path):
+    """{"calibration": {source, model, k}} from an `identify --json` result ({} without one);
+    one line naming --calibration for a file that is not one."""
+    if path is None:
+        return {}
+    import json
+    from pathlib import Path
+
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.core.models import get_model
+
+    try:
+        result = json.loads(Path(path).read_text())
+        model = get_model(result["model"])
+        k = [float(result["parameters"][name]["value"]) for name in model.params]
+    except OSError as exc:
+        raise PitotcalError(f"--calibration {path}: cannot read it ({exc.strerror})") from None
+    except (ValueError, KeyError, TypeError) as exc:
+        raise PitotcalError(f"--calibration {path}: not a pitotcal identify result (model and "
+                            f"parameters.k*.value needed; {type(exc).__name__}: {exc})") from None
+    if not all(abs(v) < float("inf") for v in k):
+        raise PitotcalError(f"--calibration {path}: coefficients must be finite, got {k}")
+    return {"calibration": {"source": Path(path).name, "model": model.name, "k": k}}
