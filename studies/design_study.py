@@ -194,6 +194,9 @@ def figure(summary):
     if len(bound) > 1:
         ax[0, 0].plot(list(bound), list(bound.values()), "k--", lw=0.8,
                       label="ideal two-point bound")
+    ref = summary["reference"].get("dv_2sigma_range_kt")
+    if ref:
+        ax[0, 0].axhline(ref, color="0.6", lw=0.6, ls="-.", label="two-speed at 240 s")
     ax[0, 0].set_ylabel("2σ of ΔV, kt (median,\nworst over 72-98 KIAS)")
     ax[0, 1].set_ylabel("truth inside ±2σ, %")
     ax[0, 1].axhspan(90, 98, color="0.9")
