@@ -52,7 +52,7 @@ def draw_track_sketch(ax, plan):
     a = np.linspace(0, 2 * np.pi, 181)
     ax.plot(radius * np.sin(a), radius * np.cos(a), color="0.5", lw=0.8)
     ax.plot(east, north, color="tab:blue", lw=0.7)
-    ax.plot(east[0], north[0], "o", color="tab:green", ms=4, label="start")
+    ax.plot(east[0], north[0], "o", color="tab:green", ms=4)
     ax.plot(0, 0, "+", color="k", ms=6)
     wind = float(s.get("wind_speed_mps", 0.0))
     if round(float(mps_to_kt(wind))) > 0:
@@ -66,9 +66,8 @@ def draw_track_sketch(ax, plan):
     ax.set_aspect("equal")
     ax.set_xlim(-1.1 * radius, 1.1 * radius)
     ax.set_ylim(-1.1 * radius, 1.1 * radius)
-    ax.set_title("track, kft (N up)", fontsize=7)
+    ax.set_title("track, kft, N up (green: start)", fontsize=7)
     ax.tick_params(labelsize=6)
-    ax.legend(loc="upper right", fontsize=6, handlelength=1)
 
 
 def kias_targets(plan):

@@ -190,6 +190,8 @@ def test_export_refuses_the_downwind_bank(tmp_path, capsys):
 
 @pytest.mark.parametrize("argv, message", [
     (["--stall-kt", "50"], "--stall-kt is for --design optimal"),
+    (["--design", "optimal", "--profile", "two-speed"],
+     "--profile two-speed is for --design paper: --design optimal chooses its own"),
     (["--design", "optimal", "--stall-kt", "62"],
      "--stall-kt 62 KCAS leaves --cas-min-kt 70 below 1.2 x the stall speed at 5° bank"),
     (["--design", "optimal", "--turbulence-mps", "0"], "--turbulence-mps 0 must be > 0"),

@@ -17,8 +17,9 @@ def add_parser(subparsers):
                     "wind and turns through every 30° heading sector in each third of the q "
                     "range. Writes PLAN.csv and beside it PLAN.card.txt/.card.png (pilot "
                     "card), PLAN.autothrottle.csv and PLAN.png (plan figure).")
-    p.add_argument("--profile", choices=PROFILES, default=T2_PLAN["profile"],
-                   help="airspeed schedule (default: %(default)s)")
+    p.add_argument("--profile", choices=PROFILES, default=None,
+                   help=f"airspeed schedule (default: {T2_PLAN['profile']}; not with "
+                        f"--design optimal, which chooses its own)")
     for name, unit in (("cas-min-kt", "KCAS"), ("cas-max-kt", "KCAS"), ("radius-m", "m"),
                        ("altitude-m", "m"), ("duration-s", "s"), ("bank-max-deg", "deg"),
                        ("wind-speed-mps", "m/s"),
@@ -70,12 +71,13 @@ def run(args):
     check_output_paths(args.output, figures=figures)
     geo = _geo_settings(args)
     calibration = _calibration(args.calibration)
+    design_options = _design_options(args)          # fills in --profile's default
     plan = plan_maneuver(
         args.profile, args.cas_min_kt, args.cas_max_kt, args.radius_m, args.altitude_m,
         args.duration_s, args.bank_max_deg, args.wind_speed_mps, args.wind_from_deg,
         roll_rate_max_dps=args.roll_rate_max_dps, accel_max_mps2=args.accel_max_mps2,
         levels=args.levels, return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s,
-        max_iter=max_iter, design=args.design, design_options=_design_options(args))
+        max_iter=max_iter, design=args.design, design_options=design_options)
     check_converged(plan, max_iter)
     if geo or calibration:
         plan = dataclasses.replace(plan, settings={**plan.settings, **geo, **calibration})
@@ -175,6 +177,15 @@ def _design_options(args):
     without --design optimal is an error, not silently ignored)."""
     given = {name: getattr(args, name) for name in _DESIGN_FLAGS
              if getattr(args, name) is not None}
+    if args.design == "optimal" and args.profile is not None:
+        from pitotcal.core.errors import PitotcalError
+
+        raise PitotcalError(f"--profile {args.profile} is for --design paper: --design optimal "
+                            f"chooses its own speed schedule")
+    if args.profile is None:
+        from pitotcal.core.scenario import T2_PLAN
+
+        args.profile = T2_PLAN["profile"]
     if args.design != "optimal":
         if given:
             from pitotcal.core.errors import PitotcalError
