@@ -89,8 +89,10 @@ def calibration_lines(s):
     if not cal:
         return []
     k = ", ".join(f"{v:.4g}" for v in cal["k"])
-    return [f"KIAS: the indicator's reading at the KCAS target, from {cal.get('source', '?')} "
-            f"({cal['model']} k = {k})"]
+    source = cal.get("source", "?")
+    line = (f"KIAS: the indicator's reading at the KCAS target, from {source} ({cal['model']} "
+            f"k = {k})")
+    return [line]
 
 
 def turn_text(s):
