@@ -16,14 +16,17 @@ __all__ = ["calibration_lines", "design_lines", "draw_card", "draw_track_sketch"
 
 
 def draw_card(plan, text, png_path):
-    """Write the card PNG: traces (top left), track sketch (top right), text (below)."""
+    """Write the card PNG: traces (top left), text (below) and, for a geo-referenced plan
+    (``center_lat_deg`` in the settings: a card to set up from), a track sketch (top right);
+    without it the card is what it was (and costs no more to draw)."""
+    sketch = "center_lat_deg" in plan.settings
     from matplotlib.figure import Figure
 
     rows = text.splitlines()
     height = 2.9 + 0.135 * len(rows)
     fig = Figure(figsize=(8.27, height))
     # top: the speed trace with its tolerance band, what the pilot is judged against
-    ax = fig.add_axes([0.09, 1 - 2.1 / height, 0.55, 1.8 / height])
+    ax = fig.add_axes([0.09, 1 - 2.1 / height, 0.55 if sketch else 0.8, 1.8 / height])
     kt = mps_to_kt(plan.cas_mps)
     ax.fill_between(plan.time_s, kt - CAS_TOLERANCE_KT, kt + CAS_TOLERANCE_KT,
                     color="tab:blue", alpha=0.2, label=f"±{CAS_TOLERANCE_KT:.0f} KCAS")
@@ -35,9 +38,10 @@ def draw_card(plan, text, png_path):
     ax.set_ylabel("KCAS")
     ax.grid(alpha=0.3)
     ax.legend(loc="upper left", fontsize=8)
-    # square in inches: 1.8 in tall, 1.8 in wide
-    sketch = fig.add_axes([0.76, 1 - 2.1 / height, 1.8 / 8.27, 1.8 / height])
-    draw_track_sketch(sketch, plan)
+    if sketch:
+        # square in inches: 1.8 in tall, 1.8 in wide
+        draw_track_sketch(fig.add_axes([0.76, 1 - 2.1 / height, 1.8 / 8.27, 1.8 / height]),
+                          plan)
     fig.text(0.04, 1 - 2.65 / height, text, family="monospace", fontsize=8, va="top")
     fig.savefig(png_path, dpi=110)
 
