@@ -124,3 +124,17 @@ def test_average_criterion_lowers_the_mean_not_the_worst(optimal):
              for name, p in (("worst", optimal), ("average", average))}
     assert bands["average"].mean() <= bands["worst"].mean() + 0.01
     assert bands["worst"].max() <= bands["average"].max() + 0.01
+
+
+def test_optimal_plan_exports_its_dwells_in_flying_order():
+    from pitotcal.maneuvers.missions import build_mission
+
+    from pitotcal.core.units import cas_from_qc_mps
+
+    plan = plan_maneuver(design="optimal", radius_m=600.0, duration_s=300.0)
+    mission = build_mission(plan, 47.39774, 8.54559)
+    levels = plan.settings["levels_qc_pa"]
+    assert len(mission.items) == 2 * len(levels) and sum(mission.loiter_s) == 300
+    np.testing.assert_allclose(mission.cas_mps, cas_from_qc_mps(np.array(levels)), rtol=1e-6)
+    speeds = [item.params[1] for item in mission.items[::2]]
+    np.testing.assert_allclose(speeds, mission.cas_mps)
