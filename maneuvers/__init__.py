@@ -29,7 +29,7 @@ _EXPORTS = {
     "export_mission": ".missions",
     "loiter_plan": ".missions",
     "plan_maneuver": ".planner",
-    "DesignOptions": ".design",
+    "DesignOptions": ".design_request",
     "predict_plan_band_kt": ".design",
     "simulate": ".simulator",
     "Tracking": ".truth",

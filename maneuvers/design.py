@@ -38,19 +38,16 @@ __all__ = [
     "CRITERIA",
     "DEFAULT_CHECK_FRACTION",
     "DEFAULT_STALL_MARGIN",
-    "MAX_TARGET_DURATION_S",
+    "GRID_POINTS",
     "ORDERS",
     "STALL_DEFAULT_RATIO",
     "Design",
-    "DesignOptions",
-    "checked_options",
     "circle_heading_rad",
+    "criterion_value",
     "default_noise",
     "design_schedule",
-    "optimal_schedule",
     "predict_band_kt",
     "predict_plan_band_kt",
-    "record_prediction",
     "stall_bank_deg",
 ]
 
@@ -68,7 +65,7 @@ ORDERS = ((0, 1, 2), (2, 1, 0), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1),
           (0, 1, 2, 0), (2, 1, 0, 2), (0, 2, 1, 0), (0, 1, 2, 0, 2),
           (0, 2), (2, 0), (0, 2, 0), (2, 0, 2), (0, 2, 0, 2))
 _LOW_SHARES = np.round(np.arange(0.25, 0.76, 0.05), 2)
-_GRID_POINTS = 7
+GRID_POINTS = 7
 
 
 @dataclass(frozen=True)
@@ -131,7 +128,8 @@ def predict_band_kt(schedule, heading_rad, wind_ne_mps, noise, vi_kt, *, model="
     return tuple(out)
 
 
-def _criterion(bands, criterion):
+def criterion_value(bands, criterion):
+    """The worst or mean, over the speeds, of the larger of (reported, actual) 2σ."""
     band = np.maximum(*bands)
     return float(band.max() if criterion == "worst" else band.mean())
 
@@ -178,7 +176,7 @@ def design_schedule(cas_min_kt, cas_max_kt, duration_s, *, altitude_m, accel_max
     q_lo, q_hi = (float(qc_from_cas_pa(kt_to_mps(v))) for v in (cas_min_kt, cas_max_kt))
     levels = (q_lo, 0.5 * (q_lo + q_hi), q_hi)
     lo_kt, hi_kt = range_kt or (cas_min_kt, cas_max_kt)
-    vi_kt = np.linspace(lo_kt, hi_kt, _GRID_POINTS)
+    vi_kt = np.linspace(lo_kt, hi_kt, GRID_POINTS)
     best, scored = None, 0
     for order in (o for o in orders if (1 in o) == (check_fraction > 0)):
         n_lo, n_hi = order.count(0), order.count(2)
@@ -197,7 +195,7 @@ def design_schedule(cas_min_kt, cas_max_kt, duration_s, *, altitude_m, accel_max
                 continue
             heading = circle_heading_rad(sched, _circle_bank(sched, radius_m, bank_max_rad,
                                                              coverage_rad))
-            value = _criterion(predict_band_kt(sched, heading, wind_ne_mps, noise, vi_kt,
+            value = criterion_value(predict_band_kt(sched, heading, wind_ne_mps, noise, vi_kt,
                                                model=model), criterion)
             scored += 1
             if best is None or value < best[0]:
@@ -230,152 +228,6 @@ def default_noise(turbulence_mps, altitude_m, tas_mps):
     scales = dryden_scales(max(altitude_m, 0.0), max(turbulence_mps, 1e-9))
     return ResidualNoise(turbulence_mps=turbulence_mps,
                          tau_s=scales.length_u_m / float(np.mean(tas_mps)))
-
-
-@dataclass(frozen=True)
-class DesignOptions:
-    """What `plan --design optimal` asks for besides the plan's own request.
-
-    Attributes
-    ----------
-    turbulence_mps : float
-        RMS Dryden gust the flight is designed for, m/s.
-    criterion : {"worst", "average"}
-        Minimise the worst or the mean 2σ of ΔV over the speed range.
-    target_2sigma_kt : float or None
-        Instead of the requested duration: the shortest flight whose criterion meets this.
-    stall_kt : float or None
-        Stall speed, KCAS (default cas_min / 1.3).
-    stall_margin : float
-        cas_min must stay this factor above the stall speed at the turn's load factor.
-    check_fraction : float
-        Dwell share of the check level.
-    """
-
-    turbulence_mps: float = 0.5
-    criterion: str = "worst"
-    target_2sigma_kt: float | None = None
-    stall_kt: float | None = None
-    stall_margin: float = DEFAULT_STALL_MARGIN
-    check_fraction: float = DEFAULT_CHECK_FRACTION
-
-
-def checked_options(options):
-    """`options` (a DesignOptions or a dict of its fields) with every field checked."""
-    from pitotcal.core.checks import choice, number, positive
-
-    if options is None:
-        options = DesignOptions()
-    elif isinstance(options, dict):
-        unknown = set(options) - set(DesignOptions.__dataclass_fields__)
-        if unknown:
-            from pitotcal.core.errors import PitotcalError
-            raise PitotcalError(f"design option {min(unknown)!r} is not one of "
-                                f"{', '.join(DesignOptions.__dataclass_fields__)}",
-                                param="design_options")
-        options = DesignOptions(**options)
-    target = options.target_2sigma_kt
-    return DesignOptions(
-        turbulence_mps=positive("turbulence_mps", options.turbulence_mps),
-        criterion=choice("criterion", options.criterion, CRITERIA),
-        target_2sigma_kt=None if target is None else positive("target_2sigma_kt", target),
-        stall_kt=None if options.stall_kt is None else positive("stall_kt", options.stall_kt),
-        stall_margin=number("stall_margin", options.stall_margin, 1.0),
-        check_fraction=number("check_fraction", options.check_fraction, 0.0, 0.5,
-                              hi_open=True))
-
-
-# The longest flight `--target-2sigma-kt` may ask for, s.
-MAX_TARGET_DURATION_S = 3600.0
-
-
-def optimal_schedule(req, options):
-    """The designed schedule of a checked planner request, and the request it is planned with
-    (the stall margin's bank limit; the duration that meets a target), and the settings to
-    record.
-
-    Parameters
-    ----------
-    req : maneuvers.planner._Request
-    options : DesignOptions (checked)
-
-    Returns
-    -------
-    (Design, bank_max_deg, duration_s, settings)
-    """
-    from pitotcal.core.units import wind_vector_mps
-
-    stall_kt = req.cas_min_kt / STALL_DEFAULT_RATIO if options.stall_kt is None \
-        else options.stall_kt
-    stall_bank = stall_bank_deg(req.cas_min_kt, stall_kt, options.stall_margin)
-    if not stall_bank >= 5.0:
-        need = options.stall_margin * stall_kt / np.sqrt(np.cos(np.radians(5.0)))
-        raise PlanInfeasibleError(
-            f"stall_kt {stall_kt:g} KCAS leaves cas_min_kt {req.cas_min_kt:g} below "
-            f"{options.stall_margin:g} x the stall speed at 5° bank: raise cas_min_kt to at "
-            f"least {np.ceil(need):.0f} KCAS", param="stall_kt", mentions=("cas_min_kt",))
-    bank_deg = min(req.bank_max_deg, stall_bank)
-    wind = wind_vector_mps(req.wind_speed_mps, req.wind_from_deg)
-
-    def run(duration_s):
-        tas_guess = kt_to_mps(0.5 * (req.cas_min_kt + req.cas_max_kt))
-        return design_schedule(
-            req.cas_min_kt, req.cas_max_kt, duration_s, altitude_m=req.altitude_m,
-            accel_max_mps2=req.accel_max_mps2, dt_s=req.dt_s,
-            bank_max_rad=np.radians(bank_deg), radius_m=req.radius_m, wind_ne_mps=wind,
-            noise=default_noise(options.turbulence_mps, req.altitude_m, [tas_guess]),
-            coverage_rad=req.coverage_rad, criterion=options.criterion,
-            check_fraction=options.check_fraction)
-
-    duration = req.duration_s
-    design = run(duration)
-    if options.target_2sigma_kt is not None:
-        duration, design = _meet_target(run, duration, design, options.target_2sigma_kt)
-    settings = {"design": "optimal", "criterion": options.criterion,
-                "turbulence_mps": options.turbulence_mps, "stall_kt": round(stall_kt, 2),
-                "stall_margin": options.stall_margin, "check_fraction": options.check_fraction,
-                "dwell_order": "-".join("LCH"[j] for j in design.order),
-                "low_share": design.low_share}
-    if options.target_2sigma_kt is not None:
-        settings["target_2sigma_kt"] = options.target_2sigma_kt
-    return design, bank_deg, duration, settings
-
-
-def _meet_target(run, duration, design, target_kt):
-    """The shortest duration (whole seconds) whose design meets the target: 2σ ~ 1/sqrt(T)
-    gives the next guess; a last step up in seconds until it holds."""
-    for _ in range(4):
-        guess = float(np.ceil(duration * (design.predicted_2sigma_kt / target_kt) ** 2))
-        if guess > MAX_TARGET_DURATION_S:
-            raise PlanInfeasibleError(
-                f"target_2sigma_kt {target_kt:g} kt needs about {guess:.0f} s of flight in "
-                f"this turbulence, more than {MAX_TARGET_DURATION_S:.0f} s: ask for a larger "
-                f"target or fly in calmer air", param="target_2sigma_kt")
-        if guess == duration:
-            break
-        try:
-            duration, design = guess, run(guess)
-        except PlanInfeasibleError:
-            # too short to turn at each end: the shortest that can, meets the target a fortiori
-            duration = guess + 10.0
-            design = run(duration)
-    while design.predicted_2sigma_kt > target_kt:
-        duration += max(1.0, round(0.01 * duration))
-        design = run(duration)
-    return duration, design
-
-
-def record_prediction(settings, schedule, sol, req, options):
-    """`settings` with the prediction on the path the OCP found: the criterion's value and the
-    worst reported 2σ of ΔV over the speed range (``predicted_dv_2sigma_kt``)."""
-    from pitotcal.core.units import wind_vector_mps
-
-    noise = default_noise(options.turbulence_mps, req.altitude_m, schedule.tas_mps)
-    vi_kt = np.linspace(req.cas_min_kt, req.cas_max_kt, _GRID_POINTS)
-    bands = predict_band_kt(schedule, sol.heading_rad,
-                            wind_vector_mps(req.wind_speed_mps, req.wind_from_deg), noise, vi_kt)
-    return {**settings, "predicted_dv_2sigma_kt": round(_criterion(bands, options.criterion), 3),
-            "turbulence_tau_s": round(noise.tau_s, 2)}
 
 
 def predict_plan_band_kt(plan, turbulence_mps, vi_kt, *, model="inverse", k=None):

@@ -171,7 +171,7 @@ def _feasible_schedule(req, design=None):
     _check_node_count(req)
     extra = {}
     if design is not None:
-        from pitotcal.maneuvers.design import optimal_schedule
+        from pitotcal.maneuvers.design_request import optimal_schedule
 
         found, bank_deg, duration_s, extra = optimal_schedule(req, design)
         req = replace(req, profile="optimal", bank_max_deg=bank_deg, duration_s=duration_s)
@@ -310,7 +310,7 @@ def _design_options(design, design_options):
     """The checked options of an optimal design; None for the paper's profiles."""
     if _choice("design", design, ("paper", "optimal")) == "paper":
         return None
-    from pitotcal.maneuvers.design import checked_options
+    from pitotcal.maneuvers.design_request import checked_options
     return checked_options(design_options)
 
 
@@ -394,6 +394,6 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
     schedule, req, extra = _feasible_schedule(req, options)
     sol = _solve(req, schedule, ipopt_options)
     if options is not None:
-        from pitotcal.maneuvers.design import record_prediction
+        from pitotcal.maneuvers.design_request import record_prediction
         extra = record_prediction(extra, schedule, sol, req, options)
     return _build_plan(req, schedule, sol, extra)
