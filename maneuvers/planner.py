@@ -167,7 +167,7 @@ def _check_turns(req, schedule):
 
 def _feasible_schedule(req, design=None):
     """The schedule of a request that passes the analytic checks (PlanInfeasibleError else),
-    and the request; `design` (maneuvers.design.DesignOptions): the designed schedule."""
+    and the request; `design` (maneuvers.design_request.DesignOptions): the designed schedule."""
     _check_node_count(req)
     extra = {}
     if design is not None:
@@ -359,7 +359,7 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         IPOPT's iteration limit.
     ipopt_options : dict, optional
         Passed to IPOPT (on top of `max_iter`).
-    design, design_options : {"paper", "optimal"}, dict or maneuvers.design.DesignOptions
+    design, design_options : {"paper", "optimal"}, dict or maneuvers.design_request.DesignOptions
         "optimal": the speed schedule designed for information (maneuvers.design) replaces
         `profile`'s (the plan's profile is then "optimal"), with these options.
 
