@@ -138,3 +138,17 @@ def test_optimal_plan_exports_its_dwells_in_flying_order():
     np.testing.assert_allclose(mission.cas_mps, cas_from_qc_mps(np.array(levels)), rtol=1e-6)
     speeds = [item.params[1] for item in mission.items[::2]]
     np.testing.assert_allclose(speeds, mission.cas_mps)
+
+
+@pytest.mark.slow
+def test_optimal_mission_flown_by_a_loitering_autopilot_is_identified_back():
+    from pitotcal.estimation import identify
+    from pitotcal.maneuvers.missions import build_mission, loiter_plan
+
+    plan = plan_maneuver(design="optimal", radius_m=600.0, duration_s=300.0)
+    mission = build_mission(plan, 47.39774, 8.54559)
+    flight, truth = simulate(loiter_plan(plan, mission), seed=3, turbulence_mps=0.5)
+    result = identify(flight)
+    for name in ("k1", "k2"):
+        z = (result.value(name) - truth.parameters[name]) / result.stddev(name)
+        assert abs(z) < 3.0, (name, z)
