@@ -192,12 +192,14 @@ def test_export_refuses_the_downwind_bank(tmp_path, capsys):
     (["--stall-kt", "50"], "--stall-kt is for --design optimal"),
     (["--design", "optimal", "--profile", "two-speed"],
      "--profile two-speed is for --design paper: --design optimal chooses its own"),
+    (["--design", "optimal", "--return"], "--return is for --design paper"),
+    (["--design", "optimal", "--levels", "3"], "--levels 3 is for --design paper"),
     (["--design", "optimal", "--stall-kt", "62"],
      "--stall-kt 62 KCAS leaves --cas-min-kt 70 below 1.2 x the stall speed at 5° bank"),
     (["--design", "optimal", "--turbulence-mps", "0"], "--turbulence-mps 0 must be > 0"),
     (["--design", "optimal", "--duration-s", "60"],
-     "--duration-s 60 s is too short for an optimal design: each end speed must turn 360° at "
-     "30° bank; 134 s is long enough"),
+     ("--duration-s 60 s is too short for an optimal design: each end speed must turn 360° at "
+      "30° bank; 134 s is long enough")),
     (["--design", "optimal", "--check-fraction", "0.7"], "--check-fraction 0.7 must be"),
 ])
 def test_design_refusals_exit_2_naming_the_flag(argv, message, tmp_path, capsys):

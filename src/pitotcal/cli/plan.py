@@ -30,7 +30,7 @@ def add_parser(subparsers):
                    help="roll-rate limit (default: 10)")
     p.add_argument("--accel-max-mps2", type=float, default=None, metavar="M/S2",
                    help="acceleration limit (default: 1)")
-    p.add_argument("--levels", type=int, default=4, help="step-pause levels (default: 4)")
+    p.add_argument("--levels", type=int, default=None, help="step-pause levels (default: 4)")
     p.add_argument("--return", dest="return_leg", action="store_true",
                    help="continuous profile: sweep back down to --cas-min-kt")
     p.add_argument("--turn", choices=(*TURNS, "both"), default=TURNS[0],
@@ -76,7 +76,7 @@ def run(args):
         args.profile, args.cas_min_kt, args.cas_max_kt, args.radius_m, args.altitude_m,
         args.duration_s, args.bank_max_deg, args.wind_speed_mps, args.wind_from_deg,
         roll_rate_max_dps=args.roll_rate_max_dps, accel_max_mps2=args.accel_max_mps2,
-        levels=args.levels, return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s,
+        levels=4 if args.levels is None else args.levels, return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s,
         max_iter=max_iter, design=args.design, design_options=design_options)
     check_converged(plan, max_iter)
     if geo or calibration:
@@ -177,11 +177,15 @@ def _design_options(args):
     without --design optimal is an error, not silently ignored)."""
     given = {name: getattr(args, name) for name in _DESIGN_FLAGS
              if getattr(args, name) is not None}
-    if args.design == "optimal" and args.profile is not None:
-        from pitotcal.core.errors import PitotcalError
+    paper_only = {"--profile": args.profile, "--levels": args.levels,
+                  "--return": args.return_leg or None}
+    for flag, value in paper_only.items():
+        if args.design == "optimal" and value is not None:
+            from pitotcal.core.errors import PitotcalError
 
-        raise PitotcalError(f"--profile {args.profile} is for --design paper: --design optimal "
-                            f"chooses its own speed schedule")
+            shown = flag if value is True else f"{flag} {value}"
+            raise PitotcalError(f"{shown} is for --design paper: --design optimal chooses its "
+                                f"own speed schedule")
     if args.profile is None:
         from pitotcal.core.scenario import T2_PLAN
 
