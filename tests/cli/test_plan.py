@@ -214,6 +214,11 @@ def test_design_optimal_card_and_csv_say_why(tmp_path, capsys):
     out = tmp_path / "opt.csv"
     assert main(["plan", "--design", "optimal", "--check-fraction", "0", "--no-figures",
                  "-o", str(out)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].startswith("optimal plan: 240 s")
+    assert re.fullmatch(r"  design: dwells [LH](-[LH])+ \(low, check, high\), \d+% of the "
+                        r"end-level time low; predicted worst 2σ of ΔV 0\.\d\d kt in 0\.5 m/s "
+                        r"turbulence", printed[2]), printed[2]
     plan = read_plan(out)
     s = plan.settings
     assert s["design"] == "optimal" and s["check_fraction"] == 0.0

@@ -94,6 +94,11 @@ def run(args):
         paths["mission"] = write_mission(mission, mission_path(args.output, args.export),
                                          args.export)
     print(plan.summary())
+    s = plan.settings
+    if s.get("design") == "optimal":
+        print(f"  design: dwells {s['dwell_order']} (low, check, high), {s['low_share']:.0%} of "
+              f"the end-level time low; predicted {s['criterion']} 2σ of ΔV "
+              f"{s['predicted_dv_2sigma_kt']:.2f} kt in {s['turbulence_mps']:g} m/s turbulence")
     for kind, path in paths.items():
         print(f"  {kind:12s} {path}")
     sys.stdout.flush()
