@@ -28,7 +28,7 @@ from pitotcal.core.information import (
     delta_v_band_kt,
     least_squares_covariance,
     qci_sensitivities,
-    residual_covariance,
+    residual_covariances,
 )
 from pitotcal.core.models import get_model
 from pitotcal.core.scenario import true_k
@@ -120,9 +120,8 @@ def predict_band_kt(schedule, heading_rad, wind_ne_mps, noise, vi_kt, *, model="
                             wind_ne_mps)
     p = len(k)
     out = []
-    for stationary in (True, False):
-        sigma = residual_covariance(schedule.time_s, schedule.tas_mps, schedule.rho_kgm3,
-                                    noise, stationary=stationary)
+    for sigma in residual_covariances(schedule.time_s, schedule.tas_mps, schedule.rho_kgm3,
+                                      noise):
         cov = least_squares_covariance(jac, sigma)
         out.append(delta_v_band_kt(pe, k, cov[:p, :p], vi_kt))
     return tuple(out)

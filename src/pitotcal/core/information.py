@@ -22,7 +22,8 @@ from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 from pitotcal.core.models import delta_v_kt, qci_from_qc_pa
 
 __all__ = ["ResidualNoise", "delta_v_band_kt", "least_squares_covariance",
-           "predicted_qci_pa", "qci_sensitivities", "residual_covariance"]
+           "predicted_qci_pa", "qci_sensitivities", "residual_covariance",
+           "residual_covariances"]
 
 
 class ResidualNoise:
@@ -90,21 +91,28 @@ def residual_covariance(time_s, tas_mps, rho_kgm3, noise, *, stationary=True):
     one autocovariance to all residuals): the bounds `identify` will report. False keeps
     rho^2 V_i^2 sigma_u^2 at each sample: the estimate's actual scatter.
     """
+    both = residual_covariances(time_s, tas_mps, rho_kgm3, noise)
+    return both[0] if stationary else both[1]
+
+
+def residual_covariances(time_s, tas_mps, rho_kgm3, noise):
+    """(stationary, actual) `residual_covariance` of one grid, sharing the AR(1) kernel."""
     t = np.asarray(time_s, dtype=float)
     v = np.asarray(tas_mps, dtype=float)
     dt = float(np.median(np.diff(t)))
     gust = rho_kgm3 * v * noise.turbulence_mps
-    if stationary:
-        gust = np.full_like(v, np.sqrt(np.mean(gust ** 2)))
-    sigma = np.outer(gust, gust) * np.exp(-np.abs(t[:, None] - t[None, :])
-                                          / max(noise.tau_s, 1e-9))
+    kernel = np.exp(-np.abs(t[:, None] - t[None, :]) / max(noise.tau_s, 1e-9))
     white = noise.qc_noise_pa ** 2 / max(dt * noise.rate_hz, 1.0)
     if noise.gps_rate_hz > 0:
         # q_c = rho V^2 / 2: a velocity error e along the track moves it by rho V e
         white = white + (rho_kgm3 * v * noise.gps_noise_mps) ** 2 / max(dt * noise.gps_rate_hz,
                                                                          1.0)
-    sigma[np.diag_indices_from(sigma)] += white
-    return sigma
+    out = []
+    for g in (np.full_like(v, np.sqrt(np.mean(gust ** 2))), gust):
+        sigma = np.outer(g, g) * kernel
+        sigma[np.diag_indices_from(sigma)] += white
+        out.append(sigma)
+    return tuple(out)
 
 
 def least_squares_covariance(jac, sigma):
