@@ -90,7 +90,20 @@ def _write_json(path, result, flight, source):
     # `identify` may carry the reader's warnings already: add only those it does not have
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
+    out.update(_monitor_noise_model(result))
     write_json(path, out)
+
+
+def _monitor_noise_model(result):
+    """{"noise_model": ...}: the residuals' noise model that `pitotcal monitor` designs its
+    thresholds from (estimation.monitor_model.noise_model); {} for a record too short."""
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.monitor_model import noise_model
+
+    try:
+        return {"noise_model": noise_model(result)}
+    except PitotcalError:
+        return {}
 
 
 def _check_plot_format(path):
