@@ -27,7 +27,7 @@ import numpy as np
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
 
-from .monitor_cusum import MonitorOptions, SequentialTest, WindTracker, design
+from .monitor_cusum import STATISTICS, MonitorOptions, SequentialTest, WindTracker, design
 from .monitor_model import Calibration, air_inputs, block_stats, predict_qci_pa
 
 __all__ = ["MonitorResult", "monitor"]
@@ -179,8 +179,8 @@ def _run(cal, opts, plan, flight, blocks, air):
     wind = WindTracker((cal.wind_n_mps, cal.wind_e_mps))
     t0, n = float(flight.time_s[0]), blocks.time_s.size
     trace = {k: np.zeros(n) for k in ("time_s", "e", "z", "y", "pred_pa", "wind_n_mps",
-                                      "wind_e_mps", "low", "high", "still", "erratic")}
-    alarms, active = [], {}
+                                      "wind_e_mps", *STATISTICS)}
+    alarms, active, settled = [], {}, False
     block_s = plan["block_s"]
     for j in range(n):
         t = float(blocks.time_s[j])
@@ -188,8 +188,11 @@ def _run(cal, opts, plan, flight, blocks, air):
         pred, grad = _predict_block(cal, inputs, j, wind.wind)
         e = (blocks.qci_pa[j] - pred) / pred
         fired, z, y = test.step(t, e, np.log(max(blocks.band_rel_var[j], 1e-30)), learning)
+        r_var = (pred * np.sqrt(test.sw2 / max(1.0 - test.a ** 2, 1e-3))) ** 2
+        if not learning and not settled:
+            wind.settle(grad, r_var, block_s, opts.wind_tau_s)
+            settled = True
         if learning or test.quiet():
-            r_var = (pred * np.sqrt(test.sw2 / max(1.0 - test.a ** 2, 1e-3))) ** 2
             wind.update(blocks.qci_pa[j] - pred, grad, r_var, block_s,
                         opts.warmup_wind_tau_s if learning else opts.wind_tau_s)
         for s in fired:
@@ -212,13 +215,18 @@ def _run(cal, opts, plan, flight, blocks, air):
     return trace, _merge(sorted(alarms, key=lambda a: a["start_s"]))
 
 
+_SAME_CAUSE_S = 5.0    # statistics firing this close to an episode's first one describe it too
+
+
 def _merge(alarms):
-    """Overlapping alarms of different statistics are one episode (the first statistic names it)."""
+    """Overlapping alarms of different statistics are one episode (the first statistic names it;
+    those that fire within _SAME_CAUSE_S of it help classify it)."""
     out = []
     for a in alarms:
         if out and a["start_s"] <= out[-1]["end_s"]:
             out[-1]["end_s"] = max(out[-1]["end_s"], a["end_s"])
-            out[-1].setdefault("also", []).append(a["statistic"])
+            if a["start_s"] - out[-1]["start_s"] <= _SAME_CAUSE_S:
+                out[-1].setdefault("also", []).append(a["statistic"])
         else:
             out.append(dict(a))
     return out

@@ -28,6 +28,8 @@ import numpy as np
 
 from pitotcal.core.checks import number, positive
 
+from .monitor_glr import RampGLR, glr_threshold
+
 __all__ = [
     "STATISTICS",
     "MonitorOptions",
@@ -38,7 +40,8 @@ __all__ = [
     "siegmund_arl",
 ]
 
-STATISTICS = ("low", "high", "still", "erratic")
+CUSUMS = ("low", "high", "still", "erratic")
+STATISTICS = (*CUSUMS, "ramp")
 _CLIP_SIGMA = 3.0          # innovations beyond this do not move the scale trackers (robust)
 _PRIOR_BLOCKS = 10.0       # weight of the calibration's noise model, in blocks of evidence
 
@@ -56,7 +59,11 @@ class MonitorOptions:
     warmup_s : float
         Start of the record where the trackers learn the flight's turbulence and wind (no alarm).
     variance_tau_s : float
-        Time constant of the scale and liveness trackers after the warm-up, s.
+        Time constant of the residual-scale tracker after the warm-up, s.
+    band_tau_s : float
+        Time constant of the liveness tracker after the warm-up, s: short, because the q_ci
+        fluctuation relative to q_ci changes with the airspeed (a frozen pitot is seen in a
+        second or two, well inside it).
     wind_tau_s, warmup_wind_tau_s : float
         Time constant of the wind tracker after / during the warm-up, s.
     """
@@ -66,12 +73,14 @@ class MonitorOptions:
     kappa_band: float = 1.0
     warmup_s: float = 30.0
     variance_tau_s: float = 120.0
+    band_tau_s: float = 20.0
     wind_tau_s: float = 180.0
     warmup_wind_tau_s: float = 10.0
 
     def checked(self):
         number("false_alarms_per_hour", self.false_alarms_per_hour, 0.0, lo_open=True)
-        for name in ("kappa", "kappa_band", "variance_tau_s", "wind_tau_s", "warmup_wind_tau_s"):
+        for name in ("kappa", "kappa_band", "variance_tau_s", "band_tau_s", "wind_tau_s",
+                     "warmup_wind_tau_s"):
             positive(name, getattr(self, name))
         number("warmup_s", self.warmup_s, 0.0)
         return self
@@ -103,7 +112,9 @@ def design(opts, block_s):
     arl_blocks = 3600.0 / block_s / share
     kappas = {"low": opts.kappa, "high": opts.kappa, "still": opts.kappa_band,
               "erratic": opts.kappa_band}
-    return {"h": {s: cusum_threshold(arl_blocks, k) for s, k in kappas.items()},
+    h = {s: cusum_threshold(arl_blocks, k) for s, k in kappas.items()}
+    h["ramp"] = glr_threshold(1.0 / arl_blocks)
+    return {"h": h,
             "kappa": kappas, "jump_sigma": float(norm.isf(1.0 / arl_blocks)),
             "arl_hours_each": 1.0 / share,
             "false_alarms_per_hour": opts.false_alarms_per_hour, "block_s": block_s}
@@ -114,12 +125,21 @@ class WindTracker:
 
     The innovation r = q_ci − predicted (Pa), with gradient g = ∂q_ci/∂W (Pa per m/s), and a
     residual variance R; the random walk's variance per block is R (Δt/τ)²/|g|², which makes
-    the steady gain ≈ Δt/τ: the wind follows the data with time constant τ.
+    the steady gain ≈ Δt/τ: the wind follows the data with time constant τ. `settle` caps the
+    covariance at that steady state (R/|g|² Δt/τ), so a change of τ takes effect at once.
     """
 
     def __init__(self, wind_ne, prior_std_mps=3.0):
         self.wind = np.array(wind_ne, dtype=float)
         self.p = np.eye(2) * prior_std_mps ** 2
+
+    def settle(self, grad, r_var, dt_s, tau_s):
+        """Cap the covariance at the steady state of `tau_s` (at the end of the warm-up: the
+        filter must not keep its fast gain, or it would learn a slow fault as wind)."""
+        gg = float(grad @ grad)
+        p_steady = r_var / gg * dt_s / tau_s if gg > 0 else 0.0
+        if 0.0 < 2.0 * p_steady < np.trace(self.p):
+            self.p *= 2.0 * p_steady / np.trace(self.p)
 
     def update(self, r_pa, grad, r_var, dt_s, tau_s):
         gg = float(grad @ grad)
@@ -149,13 +169,14 @@ class SequentialTest:
         self.n_seen = _PRIOR_BLOCKS if self.mu_l is not None else 0.0
         self.n_seen_w = _PRIOR_BLOCKS
         self.e_prev = None
+        self.ramp = RampGLR(self.a, self.block_s)
         self.values = dict.fromkeys(STATISTICS, 0.0)
         self.zero_s = dict.fromkeys(STATISTICS, None)
         self.open = set()
 
-    def quiet(self):
-        """No statistic above half its threshold: the data may teach the trackers."""
-        return all(self.values[s] < 0.5 * self.plan["h"][s] for s in STATISTICS)
+    def quiet(self, stats=STATISTICS):
+        """No statistic (of `stats`) above half its threshold: the data may teach the trackers."""
+        return all(self.values[s] < 0.5 * self.plan["h"][s] for s in stats)
 
     def step(self, t_s, e, log_band, learning):
         z = 0.0 if self.e_prev is None else (e - self.a * self.e_prev) / np.sqrt(self.sw2)
@@ -163,11 +184,13 @@ class SequentialTest:
         if self.mu_l is None:          # no liveness prior: the first block is the level
             self.mu_l, self.sl2, self.n_seen = log_band, 0.5 ** 2, 1.0
         y = (log_band - self.mu_l) / np.sqrt(self.sl2)
-        if learning or self.quiet():
-            self._learn(z, y, log_band)
+        if learning or self.quiet(("low", "high", "ramp")):
+            self._learn_scale(z)
+        if learning or self.quiet(("still", "erratic")):
+            self._learn_band(y)
         x = {"low": -z, "high": z, "still": -y, "erratic": y}
-        fired = []
-        for s in STATISTICS:
+        fired = self._ramp(t_s, z, learning)
+        for s in CUSUMS:
             h, k = self.plan["h"][s], self.plan["kappa"][s]
             v = max(0.0, self.values[s] + x[s] - k)
             if learning:
@@ -184,14 +207,31 @@ class SequentialTest:
                 self.open.discard(s)
         return tuple(fired), z, y
 
-    def _learn(self, z, y, log_band):
-        """Robust running means, fast at first (1/n), then with the slow time constant."""
-        floor = self.block_s / self.opts.variance_tau_s
+    def _ramp(self, t_s, z, learning):
+        """The ramp GLR: fires at G > h, ends below h/2; its onset is the best τ."""
+        g, m, _ = self.ramp.update(z)
+        h = self.plan["h"]["ramp"]
+        self.values["ramp"] = min(g, 0.5 * h) if learning else g
+        if learning:
+            return []
+        fired = []
+        if g > h and "ramp" not in self.open:
+            self.open.add("ramp")
+            self.zero_s["ramp"] = t_s - m * self.block_s
+            fired.append("ramp")
+        elif "ramp" in self.open and g < 0.5 * h:
+            self.open.discard("ramp")
+        return fired
+
+    # Robust running means, fast at first (1/n), then with their time constants.
+    def _learn_scale(self, z):
         self.n_seen_w += 1.0
-        wz = max(1.0 / self.n_seen_w, floor)
+        wz = max(1.0 / self.n_seen_w, self.block_s / self.opts.variance_tau_s)
         self.sw2 *= 1.0 + wz * (min(z * z, _CLIP_SIGMA ** 2) - 1.0)
+
+    def _learn_band(self, y):
         self.n_seen += 1.0
-        wy = max(1.0 / self.n_seen, floor)
+        wy = max(1.0 / self.n_seen, self.block_s / self.opts.band_tau_s)
         yc = float(np.clip(y, -_CLIP_SIGMA, _CLIP_SIGMA))
         self.mu_l += wy * yc * np.sqrt(self.sl2)
         self.sl2 *= 1.0 + wy * (yc * yc - 1.0)

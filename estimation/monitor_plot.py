@@ -32,12 +32,13 @@ def plot(result, path=None):
     ax_gs.plot(b["time_s"], mps_to_kt(speed), color="C4", lw=1.0, label="tracked wind speed")
     ax_gs.set_ylabel("kt")
     ax_gs.legend(fontsize=8, loc="best")
-    for s, color in zip(("low", "high", "still", "erratic"), ("C3", "C1", "C0", "C5")):
+    for s, color in zip(("low", "high", "still", "erratic", "ramp"),
+                        ("C3", "C1", "C0", "C5", "C2")):
         ax_s.plot(b["time_s"], b[s] / result.plan["h"][s], color=color, lw=0.9, label=s)
     ax_s.axhline(1.0, color="k", ls="--", lw=0.8)
-    ax_s.set_ylabel("CUSUM / threshold")
+    ax_s.set_ylabel("statistic / threshold")
     ax_s.set_ylim(0, 1.6)
-    ax_s.legend(fontsize=8, ncols=4, loc="upper left")
+    ax_s.legend(fontsize=8, ncols=5, loc="upper left")
     for ax in (ax_q, ax_alt, ax_gs, ax_s):
         ax.set_xlabel("time, s")
         ax.grid(alpha=0.3)

@@ -43,8 +43,8 @@ def test_threshold_design_matches_published_arl():
     # Statistical Quality Control, Table 9.3, exact 336)
     assert siegmund_arl(4.0, 0.5) == pytest.approx(336, rel=0.01)
     assert cusum_threshold(336.0, 0.5) == pytest.approx(4.0, abs=0.01)
-    plan = design(MonitorOptions(false_alarms_per_hour=0.06), 0.5)
-    # 0.06 per hour over six one-sided tests: each 100 h = 720,000 blocks
+    plan = design(MonitorOptions(false_alarms_per_hour=0.07), 0.5)
+    # 0.07 per hour over seven tests: each 100 h = 720,000 blocks
     assert siegmund_arl(plan["h"]["low"], 0.25) == pytest.approx(720_000, rel=1e-6)
     assert plan["arl_hours_each"] == pytest.approx(100.0)
 
@@ -128,3 +128,25 @@ def test_calibration_json_without_noise_model_warns(calibration, flown):
     result = monitor(flight, d)
     assert "no noise_model" in result.warnings[0]
     assert result.alarms == ()
+
+
+def test_ramp_glr_rate_and_onset():
+    """The GLR's upcrossing rate on N(0,1) innovations is the designed one (within the Monte
+    Carlo's spread), and a ramp is found with its onset."""
+    from pitotcal.estimation.monitor_glr import GLR_RATE_C, RampGLR, glr_threshold
+
+    h = glr_threshold(2e-3)
+    assert GLR_RATE_C * np.sqrt(h) * np.exp(-h) == pytest.approx(2e-3)
+    rng = np.random.default_rng(5)
+    glr, above, ups = RampGLR(0.94, 0.5), False, 0
+    for z in rng.standard_normal(20_000):
+        g = glr.update(z)[0]
+        ups += g > h and not above
+        above = g > h
+    assert 0.5 * 40 <= ups <= 1.6 * 40          # designed: 2e-3 x 20,000 = 40
+    glr = RampGLR(0.94, 0.5)
+    e = np.concatenate([np.zeros(200), -0.01 * np.arange(1, 101)])    # ramp from block 200
+    w = e[1:] - 0.94 * e[:-1]
+    for z in w / 0.002:
+        g, m, sign = glr.update(z)
+    assert g > 50 and sign < 0 and m == pytest.approx(100, abs=2)
