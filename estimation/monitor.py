@@ -27,12 +27,11 @@ import numpy as np
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
 
-from .monitor_cusum import STATISTICS, MonitorOptions, SequentialTest, WindTracker, design
-from .monitor_model import Calibration, air_inputs, block_stats, predict_qci_pa
+from .monitor_cusum import MonitorOptions
+from .monitor_model import Calibration, air_inputs, predict_qci_pa
+from .monitor_run import BlockLoop
 
-__all__ = ["MonitorResult", "monitor"]
-
-_DW = 0.1        # wind step for the prediction's gradient, m/s
+__all__ = ["LiveMonitor", "MonitorResult", "monitor"]
 
 
 @dataclass(frozen=True)
@@ -105,28 +104,50 @@ class MonitorResult:
         return plot(self, path)
 
 
-def _block_inputs(flight, blocks, air):
-    """Block means of the prediction's inputs."""
-    def mean(x):
-        if x is None:
-            return None
-        c = np.concatenate([[0.0], np.cumsum(x)])
-        return (c[blocks.stop] - c[blocks.start]) / (blocks.stop - blocks.start)
+class LiveMonitor:
+    """The monitor fed as data arrive (a live stream) or all at once (`monitor`): the same
+    blocks, the same tests, so a record gives the same alarms either way.
 
-    vd_sq = None if flight.gps_vd_mps is None else mean(flight.gps_vd_mps ** 2)
-    return (mean(flight.gps_vn_mps), mean(flight.gps_ve_mps), vd_sq, mean(flight.rho_kgm3),
-            None if air is None else (mean(air[0]), mean(air[1])))
+    `update(flight)` tests the blocks of `flight` (the record so far) that are complete and new,
+    and returns the alarms raised by them (dicts with start_s, statistic); `result(flight)`
+    finishes and returns the `MonitorResult`.
+    """
 
+    def __init__(self, calibration, options=None, air=None):
+        self.cal = (calibration if isinstance(calibration, Calibration)
+                    else Calibration.from_dict(calibration))
+        self.opts = (options or MonitorOptions()).checked()
+        self.air = air
+        self.loop = BlockLoop(self.cal, self.opts)
+        self.block_s = self.loop.block_s
 
-def _predict_block(cal, inputs, j, wind):
-    """Predicted block-mean q_ci and its gradient in the wind (Pa per m/s)."""
-    vn, ve, vd_sq, rho, air = inputs
-    winds = np.array([wind, wind + (_DW, 0.0), wind + (0.0, _DW)])
-    pick = (lambda x: None if x is None else np.full(3, x[j]))
-    q = predict_qci_pa(cal, vn[j], ve[j], pick(vd_sq), rho[j],
-                       None if air is None else (air[0][j], air[1][j]),
-                       wind_ne=(winds[:, 0], winds[:, 1]))
-    return float(q[0]), np.array([q[1] - q[0], q[2] - q[0]]) / _DW
+    @property
+    def n_blocks(self):
+        return self.loop.n_blocks
+
+    def update(self, flight, final=False):
+        air = self.air
+        if air is None and self.cal.air_data == "compressible":
+            air = air_inputs(flight)
+        return self.loop.update(flight, air, final=final)
+
+    def result(self, flight, warnings=()):
+        """The `MonitorResult` of everything fed (the last, incomplete block included)."""
+        self.update(flight, final=True)
+        trace, alarms, adapted = self.loop.snapshot(float(flight.time_s[-1]))
+        air = self.air if self.air is not None or self.cal.air_data != "compressible" \
+            else air_inputs(flight)
+        predicted = _predicted_samples(self.cal, flight, trace, air)
+        _classify(alarms, trace)
+        flagged = np.zeros(flight.n, bool)
+        for a in alarms:
+            flagged |= (flight.time_s >= a["start_s"]) & (flight.time_s <= a["end_s"])
+        extra = {"alt_m": flight.alt_m,
+                 "groundspeed_mps": np.hypot(flight.gps_vn_mps, flight.gps_ve_mps)}
+        return MonitorResult(tuple(alarms), flight.time_s, flight.qci_pa, predicted, flagged,
+                             trace, self.loop.plan, dict(self.cal.noise), adapted, self.opts,
+                             self.cal.air_data, flight.source, self.cal.source,
+                             tuple(warnings) + tuple(flight.warnings), extra)
 
 
 def monitor(flight, calibration, options=None):
@@ -143,7 +164,8 @@ def monitor(flight, calibration, options=None):
     -------
     MonitorResult
     """
-    cal = calibration if isinstance(calibration, Calibration) else Calibration.from_dict(calibration)
+    cal = (calibration if isinstance(calibration, Calibration)
+           else Calibration.from_dict(calibration))
     opts = (options or MonitorOptions()).checked()
     warnings = []
     air = air_inputs(flight) if cal.air_data == "compressible" else None
@@ -153,102 +175,33 @@ def monitor(flight, calibration, options=None):
     if cal.noise.get("fallback"):
         warnings.append(f"{cal.source}: no noise_model in the calibration (written before it "
                         f"was added); residual scale from noise_std_pa, correlation assumed")
-    blocks = block_stats(flight.time_s, flight.qci_pa, cal.noise.get("block_s", 0.5))
-    if blocks.time_s.size < 4:
-        raise FlightDataError(f"{flight.source}: {blocks.time_s.size} usable blocks of "
-                              f"{cal.noise.get('block_s', 0.5):g} s (>= 4 samples each); the "
-                              f"monitor needs more data")
-    plan = design(opts, float(cal.noise.get("block_s", 0.5)))
-    trace, alarms = _run(cal, opts, plan, flight, blocks, air)
-    predicted = _predicted_samples(cal, flight, blocks, trace, air)
-    _classify(alarms, trace, blocks)
-    flagged = np.zeros(flight.n, bool)
-    for a in alarms:
-        flagged |= (flight.time_s >= a["start_s"]) & (flight.time_s <= a["end_s"])
-    extra = {"alt_m": flight.alt_m,
-             "groundspeed_mps": np.hypot(flight.gps_vn_mps, flight.gps_ve_mps)}
-    return MonitorResult(tuple(alarms), flight.time_s, flight.qci_pa, predicted, flagged, trace,
-                         plan, dict(cal.noise), trace.pop("adapted"), opts, cal.air_data,
-                         flight.source, cal.source, tuple(warnings), extra)
+    live = LiveMonitor(cal, opts, air=air)
+    live.update(flight, final=True)
+    if live.n_blocks < 4:
+        raise FlightDataError(f"{flight.source}: {live.n_blocks} usable blocks of "
+                              f"{live.block_s:g} s (>= 4 samples each); the monitor needs more "
+                              f"data")
+    return live.result(flight, warnings)
 
 
-def _run(cal, opts, plan, flight, blocks, air):
-    """The block loop: predict, test, learn; the per-block trace and the raw alarms."""
-    inputs = _block_inputs(flight, blocks, air)
-    test = SequentialTest(cal.noise, plan, opts)
-    wind = WindTracker((cal.wind_n_mps, cal.wind_e_mps))
-    t0, n = float(flight.time_s[0]), blocks.time_s.size
-    trace = {k: np.zeros(n) for k in ("time_s", "e", "z", "y", "pred_pa", "wind_n_mps",
-                                      "wind_e_mps", *STATISTICS)}
-    alarms, active, settled = [], {}, False
-    block_s = plan["block_s"]
-    for j in range(n):
-        t = float(blocks.time_s[j])
-        learning = t - t0 < opts.warmup_s
-        pred, grad = _predict_block(cal, inputs, j, wind.wind)
-        e = (blocks.qci_pa[j] - pred) / pred
-        fired, z, y = test.step(t, e, np.log(max(blocks.band_rel_var[j], 1e-30)), learning)
-        r_var = (pred * np.sqrt(test.sw2 / max(1.0 - test.a ** 2, 1e-3))) ** 2
-        if not learning and not settled:
-            wind.settle(grad, r_var, block_s, opts.wind_tau_s)
-            settled = True
-        if learning or test.quiet():
-            wind.update(blocks.qci_pa[j] - pred, grad, r_var, block_s,
-                        opts.warmup_wind_tau_s if learning else opts.wind_tau_s)
-        for s in fired:
-            active[s] = {"start_s": t, "onset_s": test.zero_s[s], "statistic": s, "end_s": t}
-        for s in list(active):
-            active[s]["end_s"] = t
-            if s not in test.open:
-                alarms.append(active.pop(s))
-        for k, v in (("time_s", t), ("e", e), ("z", z), ("y", y), ("pred_pa", pred),
-                     ("wind_n_mps", wind.wind[0]), ("wind_e_mps", wind.wind[1])):
-            trace[k][j] = v
-        for s in test.values:
-            trace[s][j] = test.values[s]
-    for a in active.values():          # still in alarm when the record ends
-        a["end_s"] = float(flight.time_s[-1])
-        alarms.append(a)
-    trace["adapted"] = {"innovation_rel_std": float(np.sqrt(test.sw2)),
-                        "band_log_mean": test.mu_l, "band_log_std": float(np.sqrt(test.sl2)),
-                        "wind_n_mps": float(wind.wind[0]), "wind_e_mps": float(wind.wind[1])}
-    return trace, _merge(sorted(alarms, key=lambda a: a["start_s"]))
-
-
-_SAME_CAUSE_S = 5.0    # statistics firing this close to an episode's first one describe it too
-
-
-def _merge(alarms):
-    """Overlapping alarms of different statistics are one episode (the first statistic names it;
-    those that fire within _SAME_CAUSE_S of it help classify it)."""
-    out = []
-    for a in alarms:
-        if out and a["start_s"] <= out[-1]["end_s"]:
-            out[-1]["end_s"] = max(out[-1]["end_s"], a["end_s"])
-            if a["start_s"] - out[-1]["start_s"] <= _SAME_CAUSE_S:
-                out[-1].setdefault("also", []).append(a["statistic"])
-        else:
-            out.append(dict(a))
-    return out
-
-
-def _predicted_samples(cal, flight, blocks, trace, air):
+def _predicted_samples(cal, flight, trace, air):
     """The prediction at every sample with the wind tracked up to its block (held)."""
-    j = np.clip(np.searchsorted(blocks.time_s, flight.time_s), 0, blocks.time_s.size - 1)
+    j = np.clip(np.searchsorted(trace["time_s"], flight.time_s), 0, trace["time_s"].size - 1)
     vd_sq = None if flight.gps_vd_mps is None else flight.gps_vd_mps ** 2
     return predict_qci_pa(cal, flight.gps_vn_mps, flight.gps_ve_mps, vd_sq, flight.rho_kgm3,
                           air, wind_ne=(trace["wind_n_mps"][j], trace["wind_e_mps"][j]))
 
 
-def _classify(alarms, trace, blocks):
+def _classify(alarms, trace):
     """Kind and size of each alarm from its episode's data (module table)."""
     t, e, z = trace["time_s"], trace["e"], trace["z"]
     for a in alarms:
         stats = {a["statistic"], *a.pop("also", [])}
         inside = (t >= a["onset_s"]) & (t <= a["end_s"])
         level = float(e[inside][-1]) if inside.any() else float(e[-1])
-        # erratic: the innovations inside the episode far wider than the tracked scale
-        spread = float(np.sqrt(np.mean(z[inside][1:] ** 2))) if inside.sum() > 2 else 0.0
+        # erratic: the innovations inside the episode far wider than the tracked scale (their
+        # spread about their mean: a shift of the mean is a step or a drift, not erratic)
+        spread = float(np.std(z[inside][1:])) if inside.sum() > 2 else 0.0
         if level < -0.5:
             a.update(kind="drain", size=level, size_unit="fraction")
         elif "still" in stats:
@@ -258,13 +211,13 @@ def _classify(alarms, trace, blocks):
                 trace["y"][inside])))) if inside.any() else spread, size_unit="x")
         else:
             window = (t >= a["onset_s"] - _FIT_BEFORE_S) & (t <= a["end_s"])
-            a.update(_step_or_drift(t[window], e[window], blocks))
+            a.update(_step_or_drift(t[window], e[window], trace["qci_pa"]))
 
 
 _FIT_BEFORE_S = 60.0     # the change-point fits see this much of the record before the onset
 
 
-def _step_or_drift(t, e, blocks):
+def _step_or_drift(t, e, qci_pa):
     """A step (e = b + δ after τ) or a drift (e = b + s (t − τ) after τ), whichever fits the
     episode best, τ searched over the window (least squares on the block residuals)."""
     if t.size < 4:
@@ -281,6 +234,6 @@ def _step_or_drift(t, e, blocks):
     if best["step"][0] <= best["drift"][0]:
         return {"kind": "step", "size": best["step"][1], "size_unit": "fraction"}
     # q_ci ∝ V_i²: d(V_i)/V_i = ½ d(q_ci)/q_ci
-    vi_mps = np.sqrt(2.0 * float(np.median(blocks.qci_pa)) / RHO0_KGM3)
+    vi_mps = np.sqrt(2.0 * float(np.median(qci_pa)) / RHO0_KGM3)
     return {"kind": "drift", "size": float(mps_to_kt(0.5 * vi_mps * best["drift"][1] * 60.0)),
             "size_unit": "kt/min"}

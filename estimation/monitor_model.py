@@ -140,11 +140,12 @@ class Blocks:
     band_rel_var: np.ndarray
 
 
-def block_stats(time_s, qci_pa, block_s=BLOCK_S):
-    """Cut a record into blocks of `block_s` (blocks with fewer than 4 samples are left out)."""
+def block_stats(time_s, qci_pa, block_s=BLOCK_S, t0=None):
+    """Cut a record into blocks of `block_s` from `t0` (default its first time) on; blocks with
+    fewer than 4 samples are left out."""
     t = np.asarray(time_s, float)
     q = np.asarray(qci_pa, float)
-    idx = np.floor((t - t[0]) / block_s + 1e-9).astype(np.int64)
+    idx = np.floor((t - (t[0] if t0 is None else t0)) / block_s + 1e-9).astype(np.int64)
     cuts = np.flatnonzero(np.diff(idx)) + 1
     starts = np.concatenate([[0], cuts])
     stops = np.concatenate([cuts, [t.size]])

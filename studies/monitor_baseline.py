@@ -42,7 +42,8 @@ def fixed_threshold_alarms(result, flight, cal, *, innov_mps=5.0, integ_m=10.0,
     vd2 = 0.0 if flight.gps_vd_mps is None else flight.gps_vd_mps ** 2
     v_pred = np.sqrt((flight.gps_vn_mps - b["wind_n_mps"][j]) ** 2
                      + (flight.gps_ve_mps - b["wind_e_mps"][j]) ** 2 + vd2)
-    qc = qc_from_qci_pa(get_model(cal.model), cal.k, np.maximum(flight.qci_pa, 0.0))
+    # 1 Pa floor: a drained reading would divide by zero in the inverse model
+    qc = qc_from_qci_pa(get_model(cal.model), cal.k, np.maximum(flight.qci_pa, 1.0))
     tas = np.sqrt(2.0 * qc / flight.rho_kgm3)
     innov = np.abs(tas - v_pred)
     dt = np.clip(np.diff(t, prepend=t[0]), 0.01, 0.2)

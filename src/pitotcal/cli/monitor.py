@@ -19,7 +19,9 @@ def add_parser(subparsers):
                     "(frozen, drain, step, drift, erratic). Prints a summary and, as the last "
                     "line, the alarms as JSON. Exit 1 when there are alarms.")
     p.add_argument("source", metavar="SOURCE",
-                   help="flight CSV or autopilot log (.ulg, .bin, .log)")
+                   help="flight CSV, autopilot log (.ulg, .bin, .log), or a live MAVLink "
+                        "connection (udp:127.0.0.1:14550; SCALED_PRESSURE and "
+                        "GLOBAL_POSITION_INT; ends when nothing arrives for --idle-s)")
     p.add_argument("--calibration", required=True, metavar="RESULT.json",
                    help="result of pitotcal identify --json")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
@@ -31,6 +33,8 @@ def add_parser(subparsers):
                    help="use only samples with time_s <= S")
     p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
                    help="logs only: measured outside air temperature, degC")
+    p.add_argument("--idle-s", type=float, default=3.0, metavar="S",
+                   help="live: the stream has ended after S seconds without a message (3)")
     t = p.add_argument_group("test design")
     t.add_argument("--false-alarms-per-hour", type=float, default=0.02, metavar="RATE",
                    help="designed false-alarm rate per flight hour (default %(default)s)")
@@ -58,13 +62,16 @@ def _read_calibration(path):
 
 def run(args):
     import json
+    import sys
     import warnings
 
     from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor import monitor
     from pitotcal.estimation.monitor_cusum import MonitorOptions
     from pitotcal.io import read_flight
     from pitotcal.io.jsonfile import write_json
+    from pitotcal.io.mavlink_live import is_connection
 
     source = Path(args.source)
     for option, out in (("--json", args.json), ("--plot", args.plot)):
@@ -73,9 +80,15 @@ def run(args):
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
                           warmup_s=args.warmup_s).checked()
-    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
-                         oat_k=oat_k_from_c(args.oat_c))
-    result = monitor(flight, cal, opts)
+    if is_connection(args.source):
+        result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k_from_c(args.oat_c),
+                                     idle_timeout_s=args.idle_s,
+                                     on_status=lambda text: print(text, file=sys.stderr))
+        flight = buf.flight()
+    else:
+        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                             oat_k=oat_k_from_c(args.oat_c))
+        result = monitor(flight, cal, opts)
     for message in result.warnings:
         warnings.warn(message, stacklevel=2)
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-"
