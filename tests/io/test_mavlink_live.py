@@ -79,3 +79,57 @@ def test_nothing_arrives():
     with pytest.raises(FlightDataError, match=r"no airspeed \(SCALED_PRESSURE\) received"):
         buf.flight()
     assert isinstance(buf, MavlinkFlightBuffer)
+
+
+def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
+    """The ArduPlane SITL DataFlash log, as pitotcal reads it, sent as SCALED_PRESSURE and
+    GLOBAL_POSITION_INT: `identify --live` writes, the moment the stream stops, the
+    identification of the same samples read from a file (a flight CSV of them)."""
+    import json
+
+    from pitotcal.cli import main
+    from pitotcal.io import read_flight, write_flight_csv
+
+    with pytest.warns(UserWarning):
+        log = read_flight(shared_data / "ardupilot" / "arduplane_sitl.log")
+    sent = as_sent(log)[0]
+    csv = write_flight_csv(sent, tmp_path / "sitl.csv")
+    assert main(["identify", str(csv), "--json", str(tmp_path / "file.json")]) == 0
+    port = free_udp_port()
+    send_flight(sent, port)
+    assert main(["identify", "--live", f"udpin:127.0.0.1:{port}", "--json",
+                 str(tmp_path / "live.json")]) == 0
+    live = json.loads((tmp_path / "live.json").read_text())
+    offline = json.loads((tmp_path / "file.json").read_text())
+    assert live["live"]["stream_ended"] == "idle" and live["n_samples"] == sent.n
+    assert live["live"]["updates"] >= 1
+    for name, p in offline["parameters"].items():
+        assert live["parameters"][name]["value"] == pytest.approx(p["value"], rel=1e-5,
+                                                                  abs=1e-6), name
+        assert live["parameters"][name]["std"] == pytest.approx(p["std"], rel=1e-4), name
+    assert "dV at" in capsys.readouterr().err        # the live updates
+
+
+def test_monitor_cli_on_a_stream(flights, tmp_path, capsys):
+    import json
+
+    from pitotcal.cli import main
+    from pitotcal.io.jsonfile import write_json
+
+    cal, flight = flights
+    cal_json = tmp_path / "cal.json"
+    write_json(cal_json, {"model": cal.model, "parameters": {
+        "k1": {"value": cal.k[0]}, "k2": {"value": cal.k[1]},
+        "wind_speed_mps": {"value": float(np.hypot(cal.wind_n_mps, cal.wind_e_mps))},
+        "wind_from_deg": {"value": float(np.degrees(np.arctan2(-cal.wind_e_mps,
+                                                                -cal.wind_n_mps)) % 360)}},
+        "noise_model": cal.noise})
+    port = free_udp_port()
+    send_flight(flight, port)
+    code = main(["monitor", f"udpin:127.0.0.1:{port}", "--calibration", str(cal_json),
+                 "--idle-s", "1"])
+    out, err = capsys.readouterr()
+    alarms = json.loads(out.splitlines()[-1])["alarms"]
+    assert code == 1 and len(alarms) == 1 and alarms[0]["kind"] == "step"
+    assert alarms[0]["start_s"] == monitor(flight, cal).alarms[0]["start_s"]
+    assert "samples  q_ci" in err          # the live status line
