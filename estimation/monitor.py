@@ -28,7 +28,7 @@ from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
 
 from .monitor_cusum import MonitorOptions
-from .monitor_model import Calibration, air_inputs, predict_qci_pa
+from .monitor_model import Calibration, _robust_std, air_inputs, predict_qci_pa
 from .monitor_run import BlockLoop
 
 __all__ = ["LiveMonitor", "MonitorResult", "monitor"]
@@ -192,6 +192,11 @@ def _predicted_samples(cal, flight, trace, air):
                           air, wind_ne=(trace["wind_n_mps"][j], trace["wind_e_mps"][j]))
 
 
+# Innovations this much wider than their tracked scale (robust spread) are erratic: a step or a
+# drift leaves them about 1 (the scale of the turbulence); water in the lines, 3 and more.
+_ERRATIC_SPREAD = 2.0
+
+
 def _classify(alarms, trace):
     """Kind and size of each alarm from its episode's data (module table)."""
     t, e, z = trace["time_s"], trace["e"], trace["z"]
@@ -200,13 +205,16 @@ def _classify(alarms, trace):
         inside = (t >= a["onset_s"]) & (t <= a["end_s"])
         level = float(e[inside][-1]) if inside.any() else float(e[-1])
         # erratic: the innovations inside the episode far wider than the tracked scale (their
-        # spread about their mean: a shift of the mean is a step or a drift, not erratic)
-        spread = float(np.std(z[inside][1:])) if inside.sum() > 2 else 0.0
+        # robust spread about their median: the one big innovation of a jump, or a shifted
+        # mean, is a step or a drift, not erratic)
+        spread = _robust_std(z[inside]) if inside.sum() > 2 else 0.0
         if level < -0.5:
             a.update(kind="drain", size=level, size_unit="fraction")
         elif "still" in stats:
             a.update(kind="frozen", size=level, size_unit="fraction")
-        elif "erratic" in stats or spread > 3.0:
+        elif a["statistic"] == "erratic" or spread > _ERRATIC_SPREAD:
+            # (liveness rising beside a mean shift is a large leak in calm air: q_ci's own
+            # noise grows relative to a lower q_ci; that is a step, not water)
             a.update(kind="erratic", size=max(spread, float(np.exp(0.5 * np.mean(
                 trace["y"][inside])))) if inside.any() else spread, size_unit="x")
         else:
