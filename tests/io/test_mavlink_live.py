@@ -108,6 +108,20 @@ def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
                                                                   abs=1e-6), name
         assert live["parameters"][name]["std"] == pytest.approx(p["std"], rel=1e-4), name
     assert "dV at" in capsys.readouterr().err        # the live updates
+    # and `monitor` against that calibration: the stream's alarms are the file's
+    codes = []
+    for name, source in (("file", str(csv)), ("live", None)):
+        if source is None:
+            port = free_udp_port()
+            send_flight(sent, port)
+            source = f"udpin:127.0.0.1:{port}"
+        codes.append(main(["monitor", source, "--calibration", str(tmp_path / "file.json"),
+                           "--idle-s", "1", "--json", str(tmp_path / f"{name}.mon.json")]))
+    mons = [json.loads((tmp_path / f"{n}.mon.json").read_text()) for n in ("file", "live")]
+    assert codes[0] == codes[1] and len(mons[0]["alarms"]) == len(mons[1]["alarms"])
+    for a, b in zip(mons[0]["alarms"], mons[1]["alarms"]):    # the CSV rounds to 9 digits
+        assert a == {**b, "size": pytest.approx(b["size"], rel=1e-4)}
+    assert mons[0]["n_samples"] == mons[1]["n_samples"] == sent.n
 
 
 def test_monitor_cli_on_a_stream(flights, tmp_path, capsys):
