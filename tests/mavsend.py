@@ -35,7 +35,7 @@ def as_sent(flight):
     return sent, ps32, temp_c, cms, alt_mm
 
 
-def send_flight(flight, port, *, order=None, skip_gps=False, skip_pressure=False, delay_s=0.5):
+def send_flight(flight, port, *, order=None, skip_gps=False, skip_pressure=False, delay_s=0.3):
     """Send `flight` to udp 127.0.0.1:port in a thread (started after `delay_s`); `order`
     permutes the samples (out-of-order tests). Returns the thread."""
     from pymavlink import mavutil
@@ -54,7 +54,7 @@ def send_flight(flight, port, *, order=None, skip_gps=False, skip_pressure=False
             if not skip_pressure:
                 conn.mav.scaled_pressure_send(ms, float(ps32[i]),
                                               float(sent.qci_pa[i] / 100.0), int(temp_c[i]))
-            if k % 20 == 19:
+            if k % 50 == 49:
                 time.sleep(0.005)          # paced: a real link is slower than memory
         conn.close()
 

@@ -97,7 +97,7 @@ def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
     assert main(["identify", str(csv), "--json", str(tmp_path / "file.json")]) == 0
     port = free_udp_port()
     send_flight(sent, port)
-    assert main(["identify", "--live", f"udpin:127.0.0.1:{port}", "--json",
+    assert main(["identify", "--live", f"udpin:127.0.0.1:{port}", "--idle-s", "1", "--json",
                  str(tmp_path / "live.json")]) == 0
     live = json.loads((tmp_path / "live.json").read_text())
     offline = json.loads((tmp_path / "file.json").read_text())

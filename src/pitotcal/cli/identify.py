@@ -42,6 +42,8 @@ def add_parser(subparsers):
                       help="re-identify the growing maneuver every second from a MAVLink "
                            "stream (udp:127.0.0.1:14550), show dV and its 2-sigma, and write "
                            "the final result when the stream stops (or on Ctrl-C)")
+    live.add_argument("--idle-s", type=float, default=3.0, metavar="S",
+                      help="live: the stream has ended after S seconds without a message (3)")
     live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
@@ -162,7 +164,8 @@ def _run_live(args):
 
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
-        oat_k=oat_k_from_c(args.oat_c), on_fix=show)
+        oat_k=oat_k_from_c(args.oat_c), idle_timeout_s=positive("idle_s", args.idle_s),
+        on_fix=show)
     print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
     print(result.summary())

@@ -66,6 +66,7 @@ def run(args):
     import warnings
 
     from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.core.checks import positive
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor import monitor
     from pitotcal.estimation.monitor_cusum import MonitorOptions
@@ -82,7 +83,7 @@ def run(args):
                           warmup_s=args.warmup_s).checked()
     if is_connection(args.source):
         result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k_from_c(args.oat_c),
-                                     idle_timeout_s=args.idle_s,
+                                     idle_timeout_s=positive("idle_s", args.idle_s),
                                      on_status=lambda text: print(text, file=sys.stderr))
         flight = buf.flight()
     else:
