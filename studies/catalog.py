@@ -20,6 +20,7 @@ from .coverage import STUDY as COVERAGE
 from .legs_study import STUDY as LEGS
 from .design_study import STUDY as DESIGN
 from .maneuvers_study import STUDY as MANEUVERS
+from .monitor_study import STUDY as MONITOR
 from .real_alfa import STUDY as REAL_ALFA
 from .runner import RunsInterrupted, count_errors, output_folder, write_table
 from .sample_size import STUDY as SAMPLE_SIZE
@@ -33,7 +34,7 @@ log = logging.getLogger(__name__)
 
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
-                               PEERS, LEGS, DESIGN)}
+                               PEERS, LEGS, DESIGN, MONITOR)}
 
 
 class StudyInterrupted(KeyboardInterrupt):

@@ -17,7 +17,8 @@ import warnings
 
 from pitotcal import __version__
 
-COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study", "legs", "report")
+COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study", "legs", "report",
+            "monitor")
 
 
 def build_parser():

@@ -20,7 +20,7 @@ def add_parser(subparsers):
                     "pressure-error model and the wind by the output-error method, print a "
                     "summary in knots and degrees with 2-sigma bounds, and optionally write the "
                     "result as JSON and the calibration figure. The input is never modified.")
-    p.add_argument("flight", metavar="FLIGHT",
+    p.add_argument("flight", metavar="FLIGHT", nargs="?",
                    help="flight CSV (columns time_s, qc_pa, gps_vn_mps, gps_ve_mps, and rho_kgm3 "
                         "or ps_pa + oat_k) or a .ulg/.bin/.log autopilot log")
     p.add_argument("--model", default="inverse", metavar="NAME",
@@ -58,10 +58,22 @@ def add_parser(subparsers):
                         "log a QGroundControl parameter file with ASPD_SCALE_1 (the current "
                         "value and the 2-sigma as comments); exit 2 with the reason when the "
                         "flight cannot support one")
+    live = p.add_argument_group("live (a MAVLink stream instead of FLIGHT)")
+    live.add_argument("--live", metavar="CONNECTION", default=None,
+                      help="re-identify the growing maneuver every second from a MAVLink "
+                           "stream (udp:127.0.0.1:14550), show dV and its 2-sigma, and write "
+                           "the final result when the stream stops (or on Ctrl-C)")
+    live.add_argument("--idle-s", type=float, default=3.0, metavar="S",
+                      help="live: the stream has ended after S seconds without a message (3)")
+    live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
+                      help="live: say when the 2-sigma of dV at the middle airspeed is at most "
+                           "KT, so the maneuver can end (default %(default)s)")
     p.set_defaults(run=run)
 
 
 def run(args):
+    if args.live is not None or args.flight is None:
+        return _run_live(args)
     import warnings
 
     from pitotcal.cli.common import check_output, oat_k_from_c
@@ -140,7 +152,20 @@ def _write_json(path, result, flight, source):
     # `identify` may carry the reader's warnings already: add only those it does not have
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
+    out.update(_monitor_noise_model(result))
     write_json(path, out)
+
+
+def _monitor_noise_model(result):
+    """{"noise_model": ...}: the residuals' noise model that `pitotcal monitor` designs its
+    thresholds from (estimation.monitor_model.noise_model); {} for a record too short."""
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.monitor_model import noise_model
+
+    try:
+        return {"noise_model": noise_model(result)}
+    except PitotcalError:
+        return {}
 
 
 def _check_plot_format(path):
@@ -154,3 +179,56 @@ def _check_plot_format(path):
     if ext and ext not in formats:
         raise PitotcalError(f"--plot {path}: unknown figure format {ext!r}; use one of "
                             f"{', '.join(sorted(formats))}")
+
+
+def _run_live(args):
+    """`--live CONNECTION`: estimation.live.identify_stream, its updates on stderr."""
+    import sys
+
+    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.core.checks import choice, positive
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.core.models import MODELS
+    from pitotcal.estimation.live import identify_stream
+
+    if (args.live is None) == (args.flight is None):
+        raise PitotcalError("give either FLIGHT (a file) or --live CONNECTION, not both")
+    choice("model", args.model, list(MODELS))
+    positive("target_2sigma_kt", args.target_2sigma_kt)
+    for option, out in (("--json", args.json), ("--plot", args.plot)):
+        if out is not None:
+            check_output(option, out, args.live, "stream")
+    met = []
+
+    def show(fix, message):
+        if fix is None:
+            print(f"waiting: {message}", file=sys.stderr)
+            return
+        flag = ""
+        if fix.target_met and not met:
+            met.append(fix.time_s)
+            flag = f"  <- 2-sigma target {args.target_2sigma_kt:g} kt met: the maneuver can end"
+        print(f"{fix.time_s:8.1f} s {fix.n_samples:7d} samples  dV at {fix.vi_kt:5.1f} kt: "
+              f"{fix.dv_kt:+6.2f} +/- {fix.dv_2sigma_kt:5.2f} kt (2 sigma)  "
+              f"[{fix.update_s * 1000:4.0f} ms]{flag}", file=sys.stderr)
+
+    result, flight, fixes, buf = identify_stream(
+        args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
+        oat_k=oat_k_from_c(args.oat_c), idle_timeout_s=positive("idle_s", args.idle_s),
+        on_fix=show)
+    print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
+          f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
+    print(result.summary())
+    if args.json is not None:
+        from pitotcal.io.jsonfile import write_json
+        out = {**result.to_dict(), "source": args.live, "live": {
+            "updates": len(fixes), "target_2sigma_kt": args.target_2sigma_kt,
+            "target_met_at_s": met[0] if met else None, "stream_ended": buf.stopped,
+            "max_update_s": max((f.update_s for f in fixes), default=None)}}
+        out["warnings"] = list(out.get("warnings", [])) + list(flight.warnings)
+        write_json(args.json, out)
+        print(f"\nWrote {args.json}")
+    if args.plot is not None:
+        result.plot(args.plot)
+        print(f"Wrote {args.plot}")
+    return 0

@@ -48,6 +48,12 @@ def add_parser(subparsers):
                         "six-degree-of-freedom model, its atmosphere and Milspec turbulence")
     e.add_argument("--aircraft", default=None,
                    help="JSBSim aircraft (default c172x, the Cessna 172); --engine jsbsim only")
+    f = p.add_argument_group("fault (maneuvers.faults)")
+    f.add_argument("--fault", metavar="KIND:ONSET_S:SIZE", default=None,
+                   help="spoil the pitot-static record from ONSET_S on: blocked (SIZE drain "
+                        "time constant s, 0 frozen), static (SIZE s, 0 sealed), leak (SIZE "
+                        "fraction low), icing (SIZE kt/min), water (SIZE fraction); the truth "
+                        "JSON gets \"fault\"")
     p.set_defaults(run=run)
     return p
 
@@ -122,6 +128,10 @@ def run(args):
 
     model, k = _true_k(args)
     out, truth_out = _outputs(args)
+    fault = None
+    if args.fault is not None:
+        from pitotcal.maneuvers.faults import parse_fault
+        fault = parse_fault(args.fault, seed=args.seed)
     plan = read_plan(args.plan)
     flight, truth = _engine(args)(
         plan, seed=args.seed, model=model.name, k=k, wind_speed_mps=args.wind_speed_mps,
@@ -132,9 +142,17 @@ def run(args):
         qc_quantization_pa=args.qc_quantization_pa, qc_bias_pa=args.qc_bias_pa,
         qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
-        gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible")
+        gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
+        keep_history=fault is not None)
+    if fault is not None:
+        from pitotcal.maneuvers.faults import apply_fault
+        flight = apply_fault(flight, truth, fault)
     write_flight_csv(flight, out, comments={"plan": str(args.plan)})
     truth_path = write_truth_json(truth, truth_out)
+    if fault is not None:
+        from pitotcal.io.jsonfile import write_json
+        from pitotcal.maneuvers.faults import truth_with_fault
+        write_json(truth_path, truth_with_fault(truth, fault))
     print(f"wrote {args.output} ({flight.n} samples, {flight.time_s[-1] - flight.time_s[0]:.0f} s)"
           f" and {truth_path}")
     for message in tracking_warnings(truth):

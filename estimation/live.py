@@ -1,0 +1,107 @@
+"""Live use of a MAVLink stream (`pitotcal.io.mavlink_live`): the airspeed monitor as data
+arrive, and the calibration re-identified on the growing maneuver every second (the paper's
+Fig. 6, live) until its 2σ on ΔV meets a target. Whatever ends the stream — it stops, the
+connection drops, Ctrl-C — what was received is kept and the final answer is computed from it,
+the same as from a file of the same samples.
+"""
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.units import RHO0_KGM3, mps_to_kt
+from pitotcal.io.mavlink_live import read_stream
+
+__all__ = ["LiveFix", "identify_stream", "monitor_stream"]
+
+_MIN_IDENTIFY_S = 20.0      # no identification is tried on less than this much record
+
+
+def monitor_stream(source, calibration, options=None, *, oat_k=None, idle_timeout_s=3.0,
+                   on_status=None, max_s=None):
+    """Monitor a live stream; returns (MonitorResult, stream buffer).
+
+    `on_status(text)` gets a one-line status every second (samples, q_ci measured and
+    predicted, alarms so far).
+    """
+    from .monitor import LiveMonitor
+
+    live = LiveMonitor(calibration, options)
+    raised = []
+
+    def tick(buf):
+        flight = buf.flight()
+        raised.extend(live.update(flight))
+        if on_status is not None:
+            trace = live.loop.trace
+            pred = trace["pred_pa"][-1] if trace["pred_pa"] else float("nan")
+            alarms = ", ".join(f"{a['statistic']} at {a['start_s']:.1f} s" for a in raised)
+            on_status(f"{flight.time_s[-1]:8.1f} s  {flight.n:7d} samples  q_ci "
+                      f"{flight.qci_pa[-1]:7.1f} Pa  predicted {pred:7.1f} Pa  "
+                      f"alarms: {alarms or 'none'}")
+
+    buf = read_stream(source, oat_k=oat_k, idle_timeout_s=idle_timeout_s, on_tick=tick,
+                      max_s=max_s)
+    flight = buf.flight()
+    return live.result(flight, _stop_note(buf)), buf
+
+
+@dataclass(frozen=True)
+class LiveFix:
+    """One live re-identification: record length, ΔV and its 2σ at the middle V_i, seconds
+    the update took, and whether the target was met."""
+
+    time_s: float
+    n_samples: int
+    vi_kt: float
+    dv_kt: float
+    dv_2sigma_kt: float
+    update_s: float
+    target_met: bool
+
+
+def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
+                    idle_timeout_s=3.0, on_fix=None, max_s=None):
+    """Re-identify the growing maneuver every second; returns (final result, flight, fixes,
+    stream buffer). The final result is `identify` on every sample received."""
+    from .identification import identify
+
+    fixes = []
+
+    def tick(buf):
+        flight = buf.flight()
+        if flight.time_s[-1] - flight.time_s[0] < _MIN_IDENTIFY_S:
+            return
+        start = time.perf_counter()
+        try:
+            result = identify(flight, model=model)
+        except PitotcalError as exc:          # too little yet (e.g. no heading change)
+            if on_fix is not None:
+                on_fix(None, str(exc))
+            return
+        fix = _fix(result, flight, time.perf_counter() - start, target_2sigma_kt)
+        fixes.append(fix)
+        if on_fix is not None:
+            on_fix(fix, None)
+
+    buf = read_stream(source, oat_k=oat_k, idle_timeout_s=idle_timeout_s, on_tick=tick,
+                      max_s=max_s)
+    flight = buf.flight()
+    result = identify(flight, model=model)
+    return result, flight, fixes, buf
+
+
+def _fix(result, flight, update_s, target):
+    vi_kt = float(mps_to_kt(np.median(np.sqrt(2.0 * np.maximum(flight.qci_pa, 0.0) / RHO0_KGM3))))
+    dv, band = result.delta_v_kt(vi_kt)
+    dv, band = float(np.asarray(dv)), float(np.asarray(band))
+    return LiveFix(float(flight.time_s[-1]), flight.n, vi_kt, dv, band, update_s,
+                   bool(band <= target))
+
+
+def _stop_note(buf):
+    how = {"interrupted": "Ctrl-C", "idle": "no message for the idle timeout"}.get(buf.stopped,
+                                                                                buf.stopped)
+    return [f"{buf.source}: stream ended ({how}) after {buf.n} samples"]

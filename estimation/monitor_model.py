@@ -1,0 +1,195 @@
+"""What the airspeed monitor knows of a calibration: the model, the wind, the air data and the
+residual noise model, and the ONE prediction of q_ci from GPS velocity (paper section VI.B).
+
+The prediction inverts the calibration: V_t² from GPS and the wind (`core.measurement`), the
+true impact pressure from it — ½ρV_t² (`core.measurement`, incompressible) or isentropic from
+V_t², p_s and T_s (`core.airdata`, compressible) as the calibration's ``"air_data"`` says (absent:
+incompressible) — then what the pitot reads through the identified pressure error.
+
+The noise model (`noise_model`) describes the calibration's output residuals on the monitor's
+block grid (BLOCK_S): the relative residual e = (q_ci − predicted)/predicted of each block is
+AR(1) (turbulence is colored: correlation times of seconds), e_k = a e_{k−1} + w_k, and the
+log of the in-block (detrended) variance of the measured q_ci, the signal's high-frequency
+"liveness", is roughly normal. `pitotcal identify --json` writes it as ``"noise_model"``.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from pitotcal.core.checks import choice
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.models import get_model, qci_from_qc_pa
+from pitotcal.core.units import R_AIR_JKGK, RHO0_KGM3, isa_pressure_pa, kt_to_mps, wind_vector_mps
+
+__all__ = ["BLOCK_S", "Blocks", "Calibration", "block_stats", "noise_model", "predict_qci_pa"]
+
+BLOCK_S = 0.5          # the monitor's block: long enough to average GPS noise, short for speed
+_MIN_PER_BLOCK = 4     # samples a block needs (the detrended variance has n - 2 dof)
+# When the calibration carries no noise model (older result JSON): correlation of 0.5-s block
+# means in the simulator's 0.5 m/s Dryden turbulence (measured, T-2 maneuver: 0.91).
+_DEFAULT_AR1 = 0.9
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A calibration as the monitor uses it (from a result JSON or an IdentificationResult)."""
+
+    model: str
+    k: tuple
+    wind_n_mps: float
+    wind_e_mps: float
+    air_data: str
+    noise: dict
+    source: str = "<memory>"
+
+    @classmethod
+    def from_dict(cls, d, source="<memory>"):
+        """From the JSON of `pitotcal identify --json` (docs/interfaces.md §3)."""
+        try:
+            model = get_model(d["model"])
+            par = d["parameters"]
+            k = tuple(float(par[name]["value"]) for name in model.params)
+            wn, we = wind_vector_mps(float(par["wind_speed_mps"]["value"]),
+                                     float(par["wind_from_deg"]["value"]))
+        except (KeyError, TypeError, ValueError) as exc:
+            raise PitotcalError(f"{source}: not a pitotcal identify result JSON ({exc})",
+                                param="calibration") from None
+        air = choice("air_data", d.get("air_data", "incompressible"),
+                     ("incompressible", "compressible"))
+        noise = d.get("noise_model") or _fallback_noise(d)
+        return cls(model.name, k, float(wn), float(we), air, dict(noise), source)
+
+    @classmethod
+    def from_result(cls, result, air_data="incompressible"):
+        """From an `IdentificationResult` in memory (its noise model computed here)."""
+        wn, we = result.internal_params[-2:]
+        return cls(result.model, tuple(map(float, result.coefficients)), float(wn), float(we),
+                   air_data, noise_model(result))
+
+
+def _fallback_noise(d):
+    """A noise model from the residual RMS alone (results written before "noise_model")."""
+    rows = d.get("airspeed_correction") or []
+    vi = [r["vi_kt"] for r in rows if r.get("vi_kt")]
+    q_pa = 0.5 * RHO0_KGM3 * float(kt_to_mps(np.mean(vi))) ** 2 if vi else 1000.0
+    rel = float(d.get("noise_std_pa") or 0.02 * q_pa) / q_pa
+    a = _DEFAULT_AR1
+    return {"block_s": BLOCK_S, "rel_std": rel, "ar1": a,
+            "innovation_rel_std": rel * float(np.sqrt(1 - a * a)),
+            "band_log_mean": None, "band_log_std": None, "n_blocks": 0, "fallback": True}
+
+
+def air_inputs(flight):
+    """(p_s, T_s) arrays for the compressible relation: the flight's own static pressure and
+    temperature when it has them, else ISA pressure at its altitude and T = p/(R ρ); None when
+    neither is there."""
+    ps, oat = getattr(flight, "ps_pa", None), getattr(flight, "oat_k", None)
+    if ps is not None and oat is not None:
+        return np.asarray(ps, float), np.asarray(oat, float)
+    if flight.alt_m is not None and np.all(np.isfinite(flight.alt_m)):
+        ps = isa_pressure_pa(flight.alt_m)
+        return ps, ps / (R_AIR_JKGK * flight.rho_kgm3)
+    return None
+
+
+def predict_qci_pa(cal, vn, ve, vd_sq, rho, air=None, wind_ne=None):
+    """The q_ci a sound pitot-static system reads, Pa, by the calibration `cal`.
+
+    Parameters
+    ----------
+    cal : Calibration
+    vn, ve : array_like
+        GPS ground velocity north / east, m/s.
+    vd_sq : array_like or None
+        GPS vertical velocity squared, m²/s² (None: not measured).
+    rho : array_like
+        Air density, kg/m³.
+    air : (ps_pa, oat_k) or None
+        Static pressure and temperature (`air_inputs`); needed by a compressible calibration
+        (without it the incompressible relation is used).
+    wind_ne : (float, float), optional
+        Air-mass velocity north/east (the way it blows TO), m/s; default the calibration's.
+
+    Notes
+    -----
+    q_ci = q_c (1 − f(q_ci; k)), q_c = ½ρV_t² or p_s[(1 + 0.2 V_t²/(γRT_s))^3.5 − 1].
+    """
+    from pitotcal.core.measurement import impact_pressure_pa, tas_squared
+
+    wn, we = (cal.wind_n_mps, cal.wind_e_mps) if wind_ne is None else wind_ne
+    v2 = tas_squared(np.asarray(vn, float), np.asarray(ve, float), wn, we, vd_sq)
+    if cal.air_data == "compressible" and air is not None:
+        from pitotcal.core.airdata import qc_from_tas_sq_pa
+        qc = qc_from_tas_sq_pa(v2, air[0], air[1])
+    else:
+        qc = impact_pressure_pa(np.asarray(rho, float), v2)
+    return qci_from_qc_pa(get_model(cal.model), cal.k, qc)
+
+
+@dataclass(frozen=True)
+class Blocks:
+    """A record cut into BLOCK_S blocks: `start`/`stop` sample indices, `time_s` (block end,
+    when its decision is known), `qci_pa` (block mean) and `band_rel_var` (variance of q_ci
+    about its in-block linear trend, over the block mean squared)."""
+
+    start: np.ndarray
+    stop: np.ndarray
+    time_s: np.ndarray
+    qci_pa: np.ndarray
+    band_rel_var: np.ndarray
+
+
+def block_stats(time_s, qci_pa, block_s=BLOCK_S, t0=None):
+    """Cut a record into blocks of `block_s` from `t0` (default its first time) on; blocks with
+    fewer than 4 samples are left out."""
+    t = np.asarray(time_s, float)
+    q = np.asarray(qci_pa, float)
+    idx = np.floor((t - (t[0] if t0 is None else t0)) / block_s + 1e-9).astype(np.int64)
+    cuts = np.flatnonzero(np.diff(idx)) + 1
+    starts = np.concatenate([[0], cuts])
+    stops = np.concatenate([cuts, [t.size]])
+    keep = (stops - starts) >= _MIN_PER_BLOCK
+    starts, stops = starts[keep], stops[keep]
+    means, band = np.empty(starts.size), np.empty(starts.size)
+    for j, (a, b) in enumerate(zip(starts, stops)):
+        tt, qq = t[a:b] - t[a], q[a:b]
+        coef = np.polyfit(tt, qq, 1)
+        resid = qq - np.polyval(coef, tt)
+        means[j] = qq.mean()
+        band[j] = resid @ resid / max(b - a - 2, 1) / max(means[j] ** 2, 1e-9)
+    return Blocks(starts, stops, t[stops - 1], means, band)
+
+
+def noise_model(result, block_s=BLOCK_S):
+    """The calibration's residual noise model on the monitor's block grid.
+
+    Returns
+    -------
+    dict
+        block_s; rel_std (std of the blocks' relative residual e); ar1 (a, lag-one
+        correlation of e); innovation_rel_std (robust std of w = e_k − a e_{k−1}); band_log_mean
+        and band_log_std (median and robust std of log of the blocks' relative band variance);
+        n_blocks.
+    """
+    qci = np.asarray(result.qci_pa, float)
+    pred = qci - np.asarray(result.residuals_pa, float)
+    blocks = block_stats(result.time_s, qci, block_s)
+    pred_b = np.array([pred[a:b].mean() for a, b in zip(blocks.start, blocks.stop)])
+    e = (blocks.qci_pa - pred_b) / pred_b
+    if e.size < 10:
+        raise PitotcalError(f"a noise model needs >= 10 blocks of {block_s:g} s, got {e.size}")
+    e = e - e.mean()
+    a = float(np.clip(np.corrcoef(e[:-1], e[1:])[0, 1], 0.0, 0.98))
+    w = e[1:] - a * e[:-1]
+    log_band = np.log(blocks.band_rel_var)
+    return {"block_s": block_s, "rel_std": float(np.std(e)), "ar1": a,
+            "innovation_rel_std": _robust_std(w),
+            "band_log_mean": float(np.median(log_band)), "band_log_std": _robust_std(log_band),
+            "n_blocks": int(e.size)}
+
+
+def _robust_std(x):
+    """1.4826 × median absolute deviation: the std of normal data, unmoved by outliers."""
+    x = np.asarray(x, float)
+    return float(1.4826 * np.median(np.abs(x - np.median(x))))

@@ -1,0 +1,110 @@
+"""`pitotcal monitor SOURCE --calibration RESULT.json`: airspeed health monitoring
+(docs/interfaces.md, "pitotcal monitor").
+
+Exit status: 0 no alarm; 1 one or more alarms (like grep: a script can test it); 2 unusable
+input (flight, calibration or option), one stderr line naming it.
+"""
+
+from pathlib import Path
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "monitor", help="test a flight's airspeed against a calibration (health monitoring)",
+        description="Predict the pitot's q_ci from GPS velocity, the calibration's wind, model "
+                    "and air data, and test the measured q_ci with sequential tests (CUSUM) "
+                    "whose thresholds follow from the calibration's residual noise model and a "
+                    "designed false-alarm rate. The monitor learns the flight's turbulence and "
+                    "wind during a warm-up and tracks them slowly. Alarms are classified "
+                    "(frozen, drain, step, drift, erratic). Prints a summary and, as the last "
+                    "line, the alarms as JSON. Exit 1 when there are alarms.")
+    p.add_argument("source", metavar="SOURCE",
+                   help="flight CSV, autopilot log (.ulg, .bin, .log), or a live MAVLink "
+                        "connection (udp:127.0.0.1:14550; SCALED_PRESSURE and "
+                        "GLOBAL_POSITION_INT; ends when nothing arrives for --idle-s)")
+    p.add_argument("--calibration", required=True, metavar="RESULT.json",
+                   help="result of pitotcal identify --json")
+    p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
+    p.add_argument("--plot", metavar="OUT.png", default=None,
+                   help="write the figure (paper Fig. 15 style)")
+    p.add_argument("--start-s", type=float, default=None, metavar="S",
+                   help="use only samples with time_s >= S")
+    p.add_argument("--end-s", type=float, default=None, metavar="S",
+                   help="use only samples with time_s <= S")
+    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
+                   help="logs only: measured outside air temperature, degC")
+    p.add_argument("--idle-s", type=float, default=3.0, metavar="S",
+                   help="live: the stream has ended after S seconds without a message (3)")
+    t = p.add_argument_group("test design")
+    t.add_argument("--false-alarms-per-hour", type=float, default=0.02, metavar="RATE",
+                   help="designed false-alarm rate per flight hour (default %(default)s)")
+    t.add_argument("--warmup-s", type=float, default=30.0, metavar="S",
+                   help="seconds at the start to learn turbulence and wind, without alarms "
+                        "(default %(default)s)")
+    p.set_defaults(run=run)
+
+
+def _read_calibration(path):
+    import json
+
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.monitor_model import Calibration
+
+    try:
+        data = json.loads(Path(path).read_text())
+    except json.JSONDecodeError as exc:
+        raise PitotcalError(f"--calibration {path}: not JSON ({exc.msg}, line {exc.lineno})"
+                            ) from None
+    if not isinstance(data, dict):
+        raise PitotcalError(f"--calibration {path}: not a pitotcal identify result JSON")
+    return Calibration.from_dict(data, source=str(path))
+
+
+def run(args):
+    import json
+    import sys
+    import warnings
+
+    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.core.checks import positive
+    from pitotcal.estimation.live import monitor_stream
+    from pitotcal.estimation.monitor import monitor
+    from pitotcal.estimation.monitor_cusum import MonitorOptions
+    from pitotcal.io import read_flight
+    from pitotcal.io.jsonfile import write_json
+    from pitotcal.io.mavlink_live import is_connection
+
+    source = Path(args.source)
+    for option, out in (("--json", args.json), ("--plot", args.plot)):
+        if out is not None:
+            check_output(option, out, source, "flight file")
+    cal = _read_calibration(args.calibration)
+    opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
+                          warmup_s=args.warmup_s).checked()
+    if is_connection(args.source):
+        result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k_from_c(args.oat_c),
+                                     idle_timeout_s=positive("idle_s", args.idle_s),
+                                     on_status=lambda text: print(text, file=sys.stderr))
+        flight = buf.flight()
+    else:
+        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                             oat_k=oat_k_from_c(args.oat_c))
+        result = monitor(flight, cal, opts)
+    for message in result.warnings:
+        warnings.warn(message, stacklevel=2)
+    print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-"
+          f"{flight.time_s[-1]:.1f} s); calibration {args.calibration} ({cal.model}, "
+          f"{cal.air_data})")
+    print(result.summary())
+    out = result.to_dict()
+    out["warnings"] = list(out["warnings"]) + [w for w in flight.warnings
+                                               if w not in out["warnings"]]
+    if args.json is not None:
+        write_json(args.json, out)
+        print(f"Wrote {args.json}")
+    if args.plot is not None:
+        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+        result.plot(plot_path)
+        print(f"Wrote {plot_path}")
+    print(json.dumps({"alarms": out["alarms"]}))
+    return 1 if result.alarms else 0

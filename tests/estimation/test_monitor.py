@@ -1,0 +1,152 @@
+"""estimation.monitor: the threshold design against the published CUSUM ARL, the prediction
+against the simulator's truth, no alarm on clean flights (also in turbulence twice the
+calibration's), and each simulated fault found, in time and of the right kind and size."""
+
+import numpy as np
+import pytest
+from pitotcal.estimation import identify
+from pitotcal.estimation.monitor import monitor
+from pitotcal.estimation.monitor_cusum import (
+    MonitorOptions,
+    cusum_threshold,
+    design,
+    siegmund_arl,
+)
+from pitotcal.estimation.monitor_model import Calibration, predict_qci_pa
+from pitotcal.maneuvers import simulate
+from pitotcal.maneuvers.faults import Fault, apply_fault
+from plans import circle_plan
+
+from pitotcal.core.models import get_model, qci_from_qc_pa
+
+RATE_HZ = 20.0
+
+
+@pytest.fixture(scope="module")
+def plan():
+    return circle_plan(duration_s=240.0)
+
+
+@pytest.fixture(scope="module")
+def calibration(plan):
+    flight, _ = simulate(plan, seed=100, rate_hz=RATE_HZ, turbulence_mps=0.5)
+    return Calibration.from_result(identify(flight))
+
+
+@pytest.fixture(scope="module")
+def flown(plan):
+    return simulate(plan, seed=7, rate_hz=RATE_HZ, turbulence_mps=0.5, keep_history=True)
+
+
+def test_threshold_design_matches_published_arl():
+    # Siegmund's approximation at k = 0.5, h = 4: ARL0 = 336 (Montgomery, Introduction to
+    # Statistical Quality Control, Table 9.3, exact 336)
+    assert siegmund_arl(4.0, 0.5) == pytest.approx(336, rel=0.01)
+    assert cusum_threshold(336.0, 0.5) == pytest.approx(4.0, abs=0.01)
+    plan = design(MonitorOptions(false_alarms_per_hour=0.07), 0.5)
+    # 0.07 per hour over seven tests: each 100 h = 720,000 blocks
+    assert siegmund_arl(plan["h"]["low"], 0.25) == pytest.approx(720_000, rel=1e-6)
+    assert plan["arl_hours_each"] == pytest.approx(100.0)
+
+
+def test_iid_cusum_run_length_matches_design():
+    """Monte Carlo of the CUSUM on N(0,1): mean run length within 15 % of Siegmund's."""
+    rng = np.random.default_rng(0)
+    h, k, lengths = cusum_threshold(200.0, 0.5), 0.5, []
+    for _ in range(300):
+        s, n = 0.0, 0
+        while s <= h:
+            s = max(0.0, s + rng.standard_normal() - k)
+            n += 1
+        lengths.append(n)
+    assert np.mean(lengths) == pytest.approx(200.0, rel=0.15)
+
+
+def test_prediction_is_the_truth_in_calm_air(plan):
+    flight, truth = simulate(plan, seed=1, rate_hz=RATE_HZ, turbulence_mps=0.0,
+                             gps_noise_mps=0.0, qc_noise_pa=0.0, keep_history=True)
+    cal = Calibration(truth.model, truth.k, truth.wind_n_mps, truth.wind_e_mps,
+                      "incompressible", {})
+    clean = qci_from_qc_pa(get_model(truth.model), truth.k, truth.history["qc_pa"])
+    pred = predict_qci_pa(cal, flight.gps_vn_mps, flight.gps_ve_mps, flight.gps_vd_mps ** 2,
+                          flight.rho_kgm3)
+    # the GPS is held at 5 Hz: the prediction lags by up to 0.2 s of the q_ci change
+    assert np.median(np.abs(pred / clean - 1)) < 2e-3
+
+
+def test_compressible_prediction(plan):
+    flight, truth = simulate(plan, seed=1, rate_hz=RATE_HZ, turbulence_mps=0.0,
+                             gps_noise_mps=0.0, qc_noise_pa=0.0, gps_rate_hz=0.0,
+                             air_data="compressible", keep_history=True)
+    from pitotcal.estimation.monitor_model import air_inputs
+    clean = qci_from_qc_pa(get_model(truth.model), truth.k, truth.history["qc_pa"])
+    for mode, tol in (("compressible", 1e-6), ("incompressible", None)):
+        cal = Calibration(truth.model, truth.k, truth.wind_n_mps, truth.wind_e_mps, mode, {})
+        pred = predict_qci_pa(cal, flight.gps_vn_mps, flight.gps_ve_mps,
+                              flight.gps_vd_mps ** 2, flight.rho_kgm3, air_inputs(flight))
+        err = np.median(np.abs(pred / clean - 1))
+        if tol:
+            assert err < 2e-3
+        else:        # 1/2 rho V^2 is M^2/4 ~ 0.4 % low at these speeds
+            assert 2e-3 < err < 1e-2
+
+
+def test_clean_flights_no_alarm_and_adapts(plan, calibration, flown):
+    flight, _ = flown
+    assert monitor(flight, calibration).alarms == ()
+    rough, _ = simulate(plan, seed=8, rate_hz=RATE_HZ, turbulence_mps=1.0)
+    result = monitor(rough, calibration)
+    assert result.alarms == ()
+    ratio = result.adapted["innovation_rel_std"] / calibration.noise["innovation_rel_std"]
+    assert 1.5 < ratio < 2.6            # the residual scale doubled with the turbulence
+
+
+@pytest.mark.parametrize("fault,kind,within_s,size", [
+    (Fault("blocked", 120.0, 0.0), "frozen", 5.0, None),
+    (Fault("blocked", 120.0, 3.0), "drain", 5.0, None),
+    (Fault("leak", 120.0, 0.1), "step", 10.0, (-0.13, -0.07)),
+    (Fault("icing", 90.0, 4.0), "drift", 90.0, (-6.0, -2.5)),
+    (Fault("water", 120.0, 0.05), "erratic", 5.0, None)])
+def test_fault_detected_in_time(calibration, flown, fault, kind, within_s, size):
+    flight, truth = flown
+    result = monitor(apply_fault(flight, truth, fault), calibration)
+    assert len(result.alarms) == 1, result.alarms
+    alarm = result.alarms[0]
+    assert 0.0 <= alarm["start_s"] - fault.onset_s <= within_s
+    assert alarm["kind"] == kind
+    if size is not None:
+        assert size[0] <= alarm["size"] <= size[1]
+    assert result.flagged[flight.time_s > alarm["start_s"] + 1].all()
+
+
+def test_calibration_json_without_noise_model_warns(calibration, flown):
+    flight, _ = flown
+    d = {"model": calibration.model,
+         "parameters": {"k1": {"value": calibration.k[0]}, "k2": {"value": calibration.k[1]},
+                        "wind_speed_mps": {"value": 5.0}, "wind_from_deg": {"value": 270.0}},
+         "noise_std_pa": 20.0, "airspeed_correction": [{"vi_kt": 85.0}]}
+    result = monitor(flight, d)
+    assert "no noise_model" in result.warnings[0]
+    assert result.alarms == ()
+
+
+def test_ramp_glr_rate_and_onset():
+    """The GLR's upcrossing rate on N(0,1) innovations is the designed one (within the Monte
+    Carlo's spread), and a ramp is found with its onset."""
+    from pitotcal.estimation.monitor_glr import GLR_RATE_C, RampGLR, glr_threshold
+
+    h = glr_threshold(2e-3)
+    assert GLR_RATE_C * np.sqrt(h) * np.exp(-h) == pytest.approx(2e-3)
+    rng = np.random.default_rng(5)
+    glr, above, ups = RampGLR(0.94, 0.5), False, 0
+    for z in rng.standard_normal(20_000):
+        g = glr.update(z)[0]
+        ups += g > h and not above
+        above = g > h
+    assert 0.5 * 40 <= ups <= 1.6 * 40          # designed: 2e-3 x 20,000 = 40
+    glr = RampGLR(0.94, 0.5)
+    e = np.concatenate([np.zeros(200), -0.01 * np.arange(1, 101)])    # ramp from block 200
+    w = e[1:] - 0.94 * e[:-1]
+    for z in w / 0.002:
+        g, m, sign = glr.update(z)
+    assert g > 50 and sign < 0 and m == pytest.approx(100, abs=2)
