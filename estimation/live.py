@@ -63,9 +63,9 @@ class LiveFix:
 
 
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
-                    idle_timeout_s=3.0, on_fix=None, max_s=None):
+                    idle_timeout_s=3.0, on_fix=None, max_s=None, air="compressible"):
     """Re-identify the growing maneuver every second; returns (final result, flight, fixes,
-    stream buffer). The final result is `identify` on every sample received."""
+    stream buffer). The final result is `identify` (with `air`) on every sample received."""
     from .identification import identify
 
     fixes = []
@@ -76,7 +76,7 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
             return
         start = time.perf_counter()
         try:
-            result = identify(flight, model=model)
+            result = identify(flight, model=model, air=air)
         except PitotcalError as exc:          # too little yet (e.g. no heading change)
             if on_fix is not None:
                 on_fix(None, str(exc))
@@ -89,7 +89,7 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
     buf = read_stream(source, oat_k=oat_k, idle_timeout_s=idle_timeout_s, on_tick=tick,
                       max_s=max_s)
     flight = buf.flight()
-    result = identify(flight, model=model)
+    result = identify(flight, model=model, air=air)
     return result, flight, fixes, buf
 
 

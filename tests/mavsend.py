@@ -31,7 +31,8 @@ def as_sent(flight):
                    qci_pa=qci32.astype(float) * 100.0, gps_vn_mps=cms[0] / 100.0,
                    gps_ve_mps=cms[1] / 100.0, gps_vd_mps=cms[2] / 100.0,
                    alt_m=alt_mm / 1000.0,
-                   rho_kgm3=density_kgm3(ps32.astype(float) * 100.0, temp_c / 100.0 + 273.15))
+                   rho_kgm3=density_kgm3(ps32.astype(float) * 100.0, temp_c / 100.0 + 273.15),
+                   ps_pa=ps32.astype(float) * 100.0, oat_k=temp_c / 100.0 + 273.15)
     return sent, ps32, temp_c, cms, alt_mm
 
 

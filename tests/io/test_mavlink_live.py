@@ -48,9 +48,11 @@ def test_identify_stream_equals_file(flights):
     port = free_udp_port()
     send_flight(clean, port)
     fixes = []
+    # the simulated truth is q_c = ½ρV² (incompressible): both fitted as it was made
     result, got, _, _buf = identify_stream(f"udpin:127.0.0.1:{port}", idle_timeout_s=1.0,
-                                          on_fix=lambda fix, msg: fixes.append(fix))
-    offline = identify(clean)
+                                          on_fix=lambda fix, msg: fixes.append(fix),
+                                          air="incompressible")
+    offline = identify(clean, air="incompressible")
     np.testing.assert_allclose(result.params, offline.params, rtol=1e-6, atol=1e-9)
     assert got.n == clean.n
 

@@ -215,7 +215,7 @@ def _run_live(args):
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
         oat_k=oat_k_from_c(args.oat_c), idle_timeout_s=positive("idle_s", args.idle_s),
-        on_fix=show)
+        on_fix=show, air=args.air)
     print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
     print(result.summary())

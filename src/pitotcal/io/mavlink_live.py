@@ -92,7 +92,7 @@ class MavlinkFlightBuffer:
         temp = a[:, 7] if self.oat_k is None else np.full(a.shape[0], float(self.oat_k))
         return Flight(time_s=a[:, 0], qci_pa=a[:, 1], gps_vn_mps=a[:, 2], gps_ve_mps=a[:, 3],
                       rho_kgm3=density_kgm3(a[:, 6], temp), gps_vd_mps=a[:, 4], alt_m=a[:, 5],
-                      source=self.source, meta={"generator": "pitotcal mavlink_live"},
+                      ps_pa=a[:, 6], oat_k=temp, source=self.source, meta={"generator": "pitotcal mavlink_live"},
                       warnings=tuple(self.warnings()))
 
 
