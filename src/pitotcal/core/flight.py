@@ -34,6 +34,9 @@ class Flight:
     warnings : tuple of str
         Every warning the reader gave about this data (also issued with `warnings.warn`), so
         the result record can carry them.
+    ps_pa, oat_k, tat_k, rh_pct : ndarray or None
+        Static pressure (Pa), static and total air temperature (K), relative humidity (%), when
+        the data has them (issue 9; `pitotcal.core.moist_air.with_static_air` converts).
     """
 
     time_s: np.ndarray
@@ -47,6 +50,11 @@ class Flight:
     meta: dict = field(default_factory=dict)
     n_dropped: int = 0
     warnings: tuple = ()
+    # issue 9 (air data): optional channels
+    ps_pa: np.ndarray | None = None
+    oat_k: np.ndarray | None = None
+    tat_k: np.ndarray | None = None
+    rh_pct: np.ndarray | None = None
 
     @property
     def n(self):
@@ -65,4 +73,5 @@ class Flight:
         return self.select((self.time_s >= lo) & (self.time_s <= hi))
 
 
-_ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m")
+_ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m",
+           "ps_pa", "oat_k", "tat_k", "rh_pct")

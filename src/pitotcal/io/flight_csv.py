@@ -54,6 +54,7 @@ import numpy as np
 
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.flight import Flight
+from pitotcal.core.moist_air import with_static_air
 from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import density_kgm3
 
@@ -95,6 +96,8 @@ def write_flight_csv(flight, path, comments=None):
 
 REQUIRED_COLUMNS = ("time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps")
 OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m")
+# issue 9: air-data channels kept in the Flight (tat_k, rh_pct converted by core.moist_air)
+AIR_COLUMNS = ("ps_pa", "oat_k", "tat_k", "rh_pct")
 MIN_ROWS = 10
 
 
@@ -133,20 +136,25 @@ def read_flight_csv(path, start_s=None, end_s=None):
 
     qci = data[:, col["qc_pa"]]
     vn, ve = data[:, col["gps_vn_mps"]], data[:, col["gps_ve_mps"]]
+    # issue 9 item 4: static pressure, static/total temperature, humidity (core.moist_air)
+    air = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None) for c in AIR_COLUMNS}
     if "rho_kgm3" in col:
         rho = data[:, col["rho_kgm3"]]
         check_rho(name, rho)
     else:
-        ps, oat = data[:, col["ps_pa"]], data[:, col["oat_k"]]
+        ps = air["ps_pa"]
+        oat = air["oat_k"] if air["oat_k"] is not None else air["tat_k"]
         check_ps_oat(name, ps, oat)
         rho = density_kgm3(ps, oat)
     check_units(name, qci, vn, ve, rho)
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
                 for c in OPTIONAL_COLUMNS}
-    return Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
-                  gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
-                  rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
-                  n_dropped=n_dropped, warnings=(warning,) if warning else (), **optional)
+    flight = Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
+                    gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
+                    rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
+                    n_dropped=n_dropped, warnings=(warning,) if warning else (), **optional,
+                    **air)
+    return with_static_air(flight)
 
 
 def csv_kind(path):
@@ -270,12 +278,15 @@ def _used_columns(name, columns):
         density = ["rho_kgm3"]
     elif "ps_pa" in present and "oat_k" in present:
         density = ["ps_pa", "oat_k"]
+    elif "ps_pa" in present and "tat_k" in present:      # issue 9: total temperature
+        density = ["ps_pa", "tat_k"]
     else:
         found = [c for c in ("ps_pa", "oat_k") if c in present]
         also = f" (found only {found[0]})" if found else ""
         raise FlightDataError(f"{name}: missing column for density: needs rho_kgm3, or both "
                               f"ps_pa and oat_k{also}")
     use = list(REQUIRED_COLUMNS) + density + [c for c in OPTIONAL_COLUMNS if c in present]
+    use += [c for c in AIR_COLUMNS if c in present and c not in use]     # issue 9
     for c in use:
         if columns.count(c) > 1:
             raise FlightDataError(f"{name}: column {c} appears {columns.count(c)} times in the "
