@@ -21,8 +21,9 @@ The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a coun
 - humidity: relative humidity, u = 5 %RH with a humidity channel or --rh-percent, else 29 %RH
   (= 50/√3: dry air assumed, the truth anywhere in 0-100 %); ρ through the virtual temperature.
 - gps_velocity_bias: a constant GPS velocity error per axis, u = 0.05 m/s (u-blox M8/M9 speed
-  accuracy), north, east and down each, root-sum-square (a horizontal bias is absorbed by the
-  wind estimate: the term shows how little is left).
+  accuracy). A horizontal bias b is the wind's: V_g + b − W = V_g − (W − b), so the fitted wind
+  absorbs it exactly and ΔV does not move (the tests re-solve to show it); only the vertical
+  channel is re-solved.
 - gps_latency: the GPS velocity's age relative to the pressure, u = 0.05 s (a receiver's
   latency known to within a navigation cycle); the GPS channels shifted in time.
 - probe_lever_arm: a probe at y = arm on the wing sees V_t − r·y in a turn at yaw rate r
@@ -155,9 +156,9 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
 
     Notes
     -----
-    Costs two re-solves per source with a nonzero uncertainty (four more for the GPS bias:
-    north, east, down); `identify` reuses its cached solver, so at N = 16,000 the whole budget
-    is about 20 re-solves (benchmarks/bench_budget.py).
+    Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
+    vertical channel): at most 12, each reusing `identify`'s cached solver
+    (benchmarks/bench_budget.py measures the cost).
     """
     from .identification import identify
 
@@ -165,7 +166,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     rows = result.correction_table()
     vi = np.array([r["vi_kt"] for r in rows])
     stat = np.array([r["dv_2sigma_kt"] for r in rows]) / 2.0
-    kwargs = {"gps_noise_std_mps": result.gps_noise_std_mps, **identify_kwargs,
+    kwargs = {**identify_kwargs, "gps_noise_std_mps": result.gps_noise_std_mps,
               "model": result.model}
     u_rh = inputs.u_rh_pct
     if u_rh is None:
@@ -192,10 +193,10 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
         if u == 0.0:
             terms[name] = np.zeros_like(vi)
         elif name == "gps_velocity_bias":
-            parts = [sensitivity(lambda s, c=c, u=u: gps_bias(flight, c, s * u))
-                     for c in ("gps_vn_mps", "gps_ve_mps", "gps_vd_mps")
-                     if getattr(flight, c) is not None]
-            terms[name] = np.sqrt(sum(p ** 2 for p in parts))
+            # north and east: V_g + b - W = V_g - (W - b), the fit's wind takes b exactly
+            # (the tests re-solve to show it); only the vertical channel is left
+            terms[name] = (np.zeros_like(vi) if flight.gps_vd_mps is None else
+                           sensitivity(lambda s, u=u: gps_bias(flight, "gps_vd_mps", s * u)))
         else:
             perturb = PERTURBATIONS[name]
             terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u))

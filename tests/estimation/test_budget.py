@@ -63,6 +63,18 @@ def test_terms_against_first_order_formulas(fitted, budget):
     assert np.max(budget.terms_kt["gps_velocity_bias"]) < 0.01
 
 
+@pytest.mark.parametrize("channel", ["gps_vn_mps", "gps_ve_mps"])
+def test_horizontal_gps_bias_goes_to_the_wind(fitted, channel):
+    """The budget skips the horizontal GPS bias: a re-solve shows ΔV does not move."""
+    flight, result = fitted
+    vi = np.array([75.0, 95.0])
+    kw = {"model": result.model, "gps_noise_std_mps": result.gps_noise_std_mps}
+    moved = identify(bd.gps_bias(flight, channel, 0.3), **kw)
+    assert moved.delta_v_kt(vi)[0] == pytest.approx(result.delta_v_kt(vi)[0], abs=1e-6)
+    assert moved.value("wind_speed_mps") != pytest.approx(result.value("wind_speed_mps"),
+                                                          abs=1e-3)
+
+
 def test_combination_and_list(budget):
     uc = np.sqrt(budget.statistical_kt ** 2 + sum(t ** 2 for t in budget.terms_kt.values()))
     assert budget.expanded_kt == pytest.approx(2 * uc)
