@@ -65,16 +65,14 @@ def _add_budget_arguments(p):
 # (flag, default, metavar, help); the defaults and their sources: estimation/budget.py
 _BUDGET_FLAGS = (
     ("--u-oat-k", 1.0, "K", "static air temperature, K; default %(default)s"),
-    ("--u-rh-percent", None, "PCT", "relative humidity, %%RH; default 5 with a humidity, "
-                                    "else 29 (dry assumed, 0-100 %% rectangular)"),
-    ("--u-gps-velocity-mps", 0.05, "MPS", "GPS velocity bias per axis, m/s; default "
-                                          "%(default)s"),
+    ("--u-rh-percent", None, "PCT", ("relative humidity, %%RH; default 5 with a humidity, "
+                                     "else 29 (dry assumed, 0-100 %% rectangular)")),
+    ("--u-gps-velocity-mps", 0.05, "MPS", "GPS velocity bias per axis, m/s; default %(default)s"),
     ("--u-gps-latency-s", 0.05, "S", "GPS-pressure time alignment, s; default %(default)s"),
-    ("--probe-arm-m", 0.0, "M", "lateral offset of the pitot probe from the centre line, m "
-                                "(right wing +): turns make it see V_t - r y; default "
-                                "%(default)s"),
-    ("--u-qc-scale-percent", 0.1, "PCT", "transducer scale (gain), %% of reading; default "
-                                         "%(default)s"),
+    ("--probe-arm-m", 0.0, "M", ("lateral offset of the pitot probe from the centre line, m "
+                                 "(right wing +): turns make it see V_t - r y; default "
+                                 "%(default)s")),
+    ("--u-qc-scale-percent", 0.1, "PCT", "transducer gain, %% of reading; default %(default)s"),
     ("--u-qc-offset-pa", 1.0, "PA", "transducer zero offset, Pa; default %(default)s"),
 )
 
