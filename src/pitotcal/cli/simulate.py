@@ -41,8 +41,32 @@ def add_parser(subparsers):
     g.add_argument("--air-data", default="incompressible",
                    help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
                         "the paper's eq. 2; default) or compressible (isentropic, ISA p and T)")
+    a = p.add_argument_group(
+        "air-data sensors (issue 9)",
+        "with any of these the flight also logs ps_pa, oat_k or tat_k, and rh_pct")
+    a.add_argument("--tat-recovery", type=float, default=None, metavar="R",
+                   help="log a total-temperature probe of recovery factor R (tat_k) instead of "
+                        "the static oat_k")
+    a.add_argument("--rh-percent", type=float, default=None, metavar="PCT",
+                   help="relative humidity of the air: the true density uses the virtual "
+                        "temperature; logged as rh_pct")
+    a.add_argument("--probe-arm-m", type=float, default=None, metavar="M",
+                   help="pitot probe at y = M on the wing (right +): it sees V_t - r y in turns")
+    a.add_argument("--oat-bias-k", type=float, default=None, metavar="K",
+                   help="bias of the logged temperature, K")
+    a.add_argument("--gps-bias-mps", type=float, nargs=3, default=None, metavar=("N", "E", "D"),
+                   help="constant GPS velocity bias north, east, down, m/s")
     p.set_defaults(run=run)
     return p
+
+
+def _air_sensors(args):
+    """The `air_sensors` dict of the options given, or None (then the files are as before)."""
+    given = {"tat_recovery": args.tat_recovery, "rh_pct": args.rh_percent,
+             "probe_arm_m": args.probe_arm_m, "oat_bias_k": args.oat_bias_k,
+             "gps_bias_mps": None if args.gps_bias_mps is None else tuple(args.gps_bias_mps)}
+    given = {k: v for k, v in given.items() if v is not None}
+    return given or None
 
 
 def _true_k(args):
@@ -105,7 +129,7 @@ def run(args):
         qc_quantization_pa=args.qc_quantization_pa, qc_bias_pa=args.qc_bias_pa,
         qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
-        gps_latency_s=args.gps_latency_s, air_data=args.air_data)
+        gps_latency_s=args.gps_latency_s, air_data=args.air_data, air_sensors=_air_sensors(args))
     write_flight_csv(flight, out, comments={"plan": str(args.plan)})
     truth_path = write_truth_json(truth, truth_out)
     print(f"wrote {args.output} ({flight.n} samples, {flight.time_s[-1] - flight.time_s[0]:.0f} s)"

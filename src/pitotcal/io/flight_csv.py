@@ -81,7 +81,7 @@ def write_flight_csv(flight, path, comments=None):
     """
     columns = ["time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3"]
     data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
-    for name in ("gps_vd_mps", "alt_m"):
+    for name in OPTIONAL_COLUMNS + AIR_COLUMNS:
         if getattr(flight, name) is not None:
             columns.append(name)
             data.append(getattr(flight, name))
