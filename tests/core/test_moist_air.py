@@ -75,8 +75,11 @@ def test_with_static_air_recovers_truth():
 def test_with_static_air_untouched_and_refusals():
     plain = _flight()
     assert ma.with_static_air(plain) is plain
-    with pytest.raises(FlightDataError, match="tat_k needs the static pressure"):
-        ma.with_static_air(_flight(tat_k=np.full(20, 280.0)))
+    with pytest.warns(UserWarning, match="tat_k needs the static pressure .* ignored"):
+        ignored = ma.with_static_air(_flight(tat_k=np.full(20, 280.0)))
+    assert ignored.rho_kgm3 == pytest.approx(1.0) and "ignored" in ignored.warnings[-1]
+    with pytest.raises(FlightDataError, match="humidity needs the static pressure"):
+        ma.with_static_air(_flight(), rh_pct=50.0)
     with pytest.raises(PitotcalError, match="temp_recovery"):
         ma.with_static_air(plain, temp_recovery=1.5)
     with pytest.raises(PitotcalError, match="rh_percent"):

@@ -20,6 +20,7 @@ static `oat_k`, and `rho_kgm3` through the virtual temperature.
 """
 
 import dataclasses
+import warnings
 
 import numpy as np
 
@@ -121,7 +122,9 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     PitotcalError
         `temp_recovery` outside [0, 1], `rh_pct` outside [0, 100].
     FlightDataError
-        Total temperature or humidity without the static pressure to convert them.
+        `rh_pct` given for a flight without the static pressure. (Columns `tat_k` or `rh_pct`
+        without `ps_pa` are ignored with a warning, also in `Flight.warnings`: the density is
+        then the file's `rho_kgm3`.)
     """
     temp_recovery = number("temp_recovery", temp_recovery, 0.0, 1.0)
     if rh_pct is not None:
@@ -132,11 +135,16 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     rh = flight.rh_pct if rh_pct is None else np.full(flight.n, rh_pct)
     if tat is None and rh is None:
         return flight
-    ps = getattr(flight, "ps_pa", None)
+    ps = flight.ps_pa
     if ps is None:
         what = "tat_k" if tat is not None and oat is None else "the humidity"
-        raise FlightDataError(f"{flight.source}: {what} needs the static pressure (column "
-                              "ps_pa) to convert it")
+        message = (f"{flight.source}: {what} needs the static pressure (column ps_pa) to "
+                   "convert it")
+        if rh_pct is not None:            # asked for explicitly: cannot be honoured
+            raise FlightDataError(message, param="rh_percent")
+        message += "; ignored, the density is the file's rho_kgm3"
+        warnings.warn(message, stacklevel=2)
+        return dataclasses.replace(flight, warnings=(*flight.warnings, message))
     meta = dict(flight.meta)
     if oat is None:
         oat = static_temperature_k(tat, flight.qci_pa, ps, temp_recovery)
