@@ -20,6 +20,7 @@ __all__ = ["PROBE_ARM_M", "STUDY", "TURBULENCE_MPS"]
 TURBULENCE_MPS = (0.0, 0.5, 1.5)
 QUICK_TURBULENCE_MPS = (0.0,)
 PROBE_ARM_M = 1.0
+_FLOOR_KT = 1e-4          # bars below this (the GPS bias, taken by the wind) drawn at it
 
 
 def task(seed, turbulence_mps):
@@ -86,9 +87,12 @@ def plot(rows, summary, out_dir):
     width = 0.8 / len(levels)
     x = np.arange(len(sources))
     for i, level in enumerate(levels):
-        u = [max(by[level]["u_dv_kt"][s], 1e-4) for s in sources]
-        ax.bar(x + (i - (len(levels) - 1) / 2) * width, u, width,
-               label=f"turbulence {level} m/s (U = {by[level]['U_kt']:.2f} kt)")
+        u = [max(by[level]["u_dv_kt"][s], _FLOOR_KT) for s in sources]
+        at = x + (i - (len(levels) - 1) / 2) * width
+        ax.bar(at, u, width, label=f"turbulence {level} m/s (U = {by[level]['U_kt']:.2f} kt)")
+        for xi, ui in zip(at, u):
+            if ui <= _FLOOR_KT:                 # nothing to draw on a log axis: say so
+                ax.text(xi, _FLOOR_KT * 1.2, "≈0", ha="center", fontsize=7)
     ax.set_yscale("log")
     ax.set_xticks(x, [s.replace("_", "\n") for s in sources], fontsize=8)
     ax.set_ylabel("standard uncertainty of ΔV, kt (max over V_i)")
