@@ -4,7 +4,7 @@ Run: ``python benchmarks/bench_budget.py [--repeats 5] [--sizes 4000 16000 10000
 For each N, a synthetic flight (5 Hz held GPS with a vertical channel, 0.05 m/s GPS noise,
 0.5 Pa pressure noise, light turbulence): the median time of `identify` (the baseline, its
 solver cached) and of `uncertainty_budget` with the default inputs and a 1 m probe arm (every
-source re-solved: 12 solves), and their ratio, measured in the same run; then the whole
+source re-solved: 14 solves), and their ratio, measured in the same run; then the whole
 `pitotcal identify` command with and without the budget, alternating. Prints markdown tables.
 """
 
@@ -46,7 +46,7 @@ def main(argv=None):
         t_id = _median_s(lambda f=flight: identify(f), args.repeats)
         t_b = _median_s(lambda f=flight, r=result: uncertainty_budget(f, r, inputs),
                         args.repeats)
-        print(f"| {n:,} | {t_id:.3f} | {t_b:.3f} | 12 | {t_b / t_id:.1f} |")
+        print(f"| {n:,} | {t_id:.3f} | {t_b:.3f} | 14 | {t_b / t_id:.1f} |")
     _command(synthetic_flight, args.repeats)
 
 

@@ -157,7 +157,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     Notes
     -----
     Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
-    vertical channel): at most 12, each reusing `identify`'s cached solver
+    vertical channel): at most 14, each reusing `identify`'s cached solver
     (benchmarks/bench_budget.py measures the cost).
     """
     from .identification import identify

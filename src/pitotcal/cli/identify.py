@@ -57,7 +57,7 @@ def _add_budget_arguments(p):
         "each given as a standard uncertainty and propagated by re-solving the perturbed "
         "flight; reported as the expanded uncertainty U (k = 2)")
     bud.add_argument("--no-budget", action="store_true",
-                     help="skip the budget (up to 12 extra solves)")
+                     help="skip the budget (up to 14 extra solves)")
     for flag, default, metavar, text in _BUDGET_FLAGS:
         bud.add_argument(flag, type=float, default=default, metavar=metavar, help=text)
 
