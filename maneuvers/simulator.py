@@ -315,9 +315,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         Also return the true time histories as numpy arrays in truth.history (not written
         by `write_truth_json`).
     air_sensors : maneuvers.sim_options.AirSensors or dict, optional
-        Total-temperature probe, humidity, probe lever arm, OAT and GPS velocity biases
-        (issue 9); the flight then also logs ps_pa, oat_k or tat_k, and rh_pct. None: none
-        of them, and the records are as before.
+        TAT probe, humidity, probe arm, OAT/GPS biases (issue 9); None: records as before.
 
     Returns
     -------
