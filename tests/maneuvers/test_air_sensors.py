@@ -67,7 +67,7 @@ def test_bad_sensor_options(bad, match):
 
 # --- each effect injected, and the budget term that should cover it -------------------------
 
-PLAN = {"duration_s": 180.0, "cas_kt": (70.0, 100.0), "radius_m": 600.0}
+PLAN = {"duration_s": 120.0, "cas_kt": (70.0, 100.0), "radius_m": 600.0}
 SIM = {"seed": 11, "rate_hz": 10.0, "turbulence_mps": 0.3}
 ZERO = bd.BudgetInputs(u_oat_k=0, u_rh_pct=0, u_gps_velocity_mps=0, u_gps_latency_s=0,
                        u_qc_scale=0, u_qc_offset_pa=0)
