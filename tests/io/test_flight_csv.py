@@ -348,3 +348,9 @@ def test_total_temperature_and_humidity_columns(tmp_path):
     flight = read_flight(plain)
     assert flight.rho_kgm3 == pytest.approx(ps / (287.05287 * ts), rel=1e-8)
     assert flight.tat_k is None and flight.oat_k == pytest.approx(ts)
+    # with rho_kgm3 as well, a bad oat_k cell is no reason to drop the row (it is not used)
+    oat = ts.copy()
+    oat[5] = np.nan
+    both = write(tmp_path / "both.csv", {**cols, "rho_kgm3": np.full(N, 1.1), "ps_pa": ps,
+                                         "oat_k": oat})
+    assert read_flight(both).n == N and read_flight(both).n_dropped == 0

@@ -286,7 +286,8 @@ def _used_columns(name, columns):
         raise FlightDataError(f"{name}: missing column for density: needs rho_kgm3, or both "
                               f"ps_pa and oat_k{also}")
     use = list(REQUIRED_COLUMNS) + density + [c for c in OPTIONAL_COLUMNS if c in present]
-    use += [c for c in AIR_COLUMNS if c in present and c not in use]     # issue 9
+    if present & {"tat_k", "rh_pct"}:        # issue 9: what converting them needs
+        use += [c for c in AIR_COLUMNS if c in present and c not in use]
     for c in use:
         if columns.count(c) > 1:
             raise FlightDataError(f"{name}: column {c} appears {columns.count(c)} times in the "
