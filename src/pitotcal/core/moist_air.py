@@ -51,7 +51,7 @@ def saturation_vapour_pressure_pa(t_k):
     Example
     -------
     >>> round(float(saturation_vapour_pressure_pa(293.15)))        # table: 2339 Pa at 20 °C
-    2335
+    2333
     """
     t_c = np.asarray(t_k, dtype=float) - _C_TO_K
     return _AE_A_PA * np.exp(_AE_B * t_c / (t_c + _AE_C_C))
