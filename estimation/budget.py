@@ -231,7 +231,7 @@ def oat_error(flight, result, dt_k):
 
 
 def humidity_error(flight, result, drh_pct):
-    """Relative humidity drh_pct higher (lower): ρ scaled through the virtual temperature.
+    """Relative humidity drh_pct higher (lower): ρ and T_v (`oat_k`) through the virtual temperature.
 
     The density change of +|drh| from the flight's humidity (0 when it has none, capped at
     100 %RH) with the sign of drh, so the two sides of the central difference are symmetric.
@@ -241,7 +241,11 @@ def humidity_error(flight, result, drh_pct):
     rh0 = np.zeros(flight.n) if flight.rh_pct is None else np.asarray(flight.rh_pct, float)
     hi = np.minimum(rh0 + abs(drh_pct), 100.0)
     rel = moist_density_kgm3(ps, t, hi) / moist_density_kgm3(ps, t, rh0) - 1.0
-    return dataclasses.replace(flight, rho_kgm3=flight.rho_kgm3 * (1.0 + np.sign(drh_pct) * rel))
+    factor = 1.0 + np.sign(drh_pct) * rel
+    out = {"rho_kgm3": flight.rho_kgm3 * factor}
+    if flight.oat_k is not None:          # the virtual temperature the compressible fit uses
+        out["oat_k"] = flight.oat_k / factor
+    return dataclasses.replace(flight, **out)
 
 
 def gps_bias(flight, channel, bias_mps):

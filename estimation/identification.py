@@ -6,6 +6,7 @@ import logging
 import numpy as np
 
 from pitotcal.core import checks
+from pitotcal.core.airdata import AIR_DATA_MODES
 from pitotcal.core.errors import FlightDataError, ObservabilityError
 from pitotcal.core.models import MODELS, get_model
 
@@ -29,7 +30,8 @@ MAX_CORRELATION = 0.9995
 _PROBLEMS = {}
 
 
-def identify(flight, model="inverse", *, gps_noise_std_mps=None, ipopt_options=None):
+def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
+             ipopt_options=None):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -39,6 +41,15 @@ def identify(flight, model="inverse", *, gps_noise_std_mps=None, ipopt_options=N
     model : {"inverse", "constant", "linear", "auto"}
         Pressure-error structure (docs/interfaces.md §2); "auto" fits every structure in
         `pitotcal.core.models.MODELS` and keeps the one with the lowest BIC.
+    air : {"compressible", "incompressible"}
+        How the impact pressure follows from the true airspeed (`estimation.residual`):
+        isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
+        temperature `oat_k`, with all the pressure error in the static source (the default),
+        or the paper's eq. 2, q_c = ½ρV_t² ("incompressible", results as before issue 9). A
+        flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
+        an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
+        it instead, and the static and total pressure errors are separated
+        (`estimation.static_source`).
     gps_noise_std_mps : float, optional
         GPS velocity noise per component, m/s, for the errors-in-variables correction;
         estimated from the data when None.
@@ -89,24 +100,27 @@ def identify(flight, model="inverse", *, gps_noise_std_mps=None, ipopt_options=N
     if gps_noise_std_mps is not None:
         gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0)
     ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
-    _check_flight(flight)
+    checks.choice("air", air, AIR_DATA_MODES)
+    air_data, air_note = _air_data(flight, air)
+    _check_flight(flight, air_data)
     _check_track(flight)
 
     if model == "auto":
-        result = _identify_auto(flight, gps_noise_std_mps, ipopt_options)
+        result = _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data)
     else:
-        result = _identify_one(flight, model, gps_noise_std_mps, ipopt_options)
+        result = _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data)
     # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
-    warn = tuple(dict.fromkeys(tuple(flight.warnings) + tuple(result.warnings)))
+    warn = tuple(dict.fromkeys(tuple(flight.warnings) + tuple(result.warnings) + air_note))
     return dataclasses.replace(result, warnings=warn)
 
 
-def _identify_auto(flight, gps_noise_std_mps, ipopt_options):
+def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data):
     """Every structure in MODELS, the one with the lowest BIC kept (see `identify` Notes)."""
     results, candidates = {}, []
     for name in MODELS:
         try:
-            results[name] = _identify_one(flight, name, gps_noise_std_mps, ipopt_options)
+            results[name] = _identify_one(flight, name, gps_noise_std_mps, ipopt_options,
+                                          air_data)
         except ObservabilityError as exc:
             candidates.append({"model": name, "bic": None, "error": str(exc)})
     if not results:
@@ -135,24 +149,41 @@ def _candidate(result, n_eff):
             "params": dict(zip(result.param_names, map(float, result.params)))}
 
 
-def _identify_one(flight, model, gps_noise_std_mps, ipopt_options):
+def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data):
     m = get_model(model)
     if len(m.params) > 1:
         _check_qci_span(flight, m)
     key = (model, tuple(sorted(ipopt_options.items())))
     if key not in _PROBLEMS:
         _PROBLEMS[key] = OutputErrorProblem(model, ipopt_options=ipopt_options)
-    result = _PROBLEMS[key].solve(flight, gps_noise_std_mps=gps_noise_std_mps)
+    result = _PROBLEMS[key].solve(flight, gps_noise_std_mps=gps_noise_std_mps,
+                                  air_data=air_data)
     if result.success:
         _check_information(result)
     return result
 
 
-def _check_flight(flight):
+def _air_data(flight, air):
+    """(the air-data mode used, warnings): compressible needs the flight's ps_pa and oat_k."""
+    if air == "compressible" and flight.ps_ref_pa is not None and flight.ps_pa is not None \
+            and flight.oat_k is not None:
+        return "reference", ()
+    if air == "compressible" and (flight.ps_pa is None or flight.oat_k is None):
+        return "incompressible", ((
+            f"{flight.source}: no static pressure and temperature (ps_pa, oat_k): fitted with "
+            "the incompressible q_c = rho V_t^2 / 2 (as --air incompressible), so V_c and dV "
+            "are sqrt(2 q / rho0), not the standard calibrated airspeed; give ps_pa and oat_k "
+            "for the compressible calibration"),)
+    return air, ()
+
+
+def _check_flight(flight, air_data="incompressible"):
     n = flight.n
     if n < MIN_SAMPLES:
         raise FlightDataError(f"{flight.source}: {n} samples; identification needs at least {MIN_SAMPLES}")
-    for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps"):
+    air = {"compressible": ("ps_pa", "oat_k"),
+           "reference": ("ps_pa", "oat_k", "ps_ref_pa")}.get(air_data, ())
+    for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", *air):
         values = getattr(flight, name)
         if values is None:
             continue
@@ -161,6 +192,9 @@ def _check_flight(flight):
         bad = ~np.isfinite(values)
         if bad.any():
             raise FlightDataError(f"{flight.source}: {name}, row {int(np.argmax(bad)) + 1}: not finite")
+        if name in air and np.any(values <= 0):
+            raise FlightDataError(f"{flight.source}: {name}, row "
+                                  f"{int(np.argmax(values <= 0)) + 1}: not positive")
 
 
 def track_spread_deg(vn_mps, ve_mps):

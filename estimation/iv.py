@@ -17,7 +17,7 @@ import numpy as np
 
 from pitotcal.core.models import qc_from_qci_pa
 
-from .residual import ratio_columns, residual, sensitivities, slope
+from .residual import ratio_columns, residual, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
 __all__ = ["IV_WINDOW_S", "instruments", "iv_refine", "smooth_in_time"]
@@ -68,9 +68,9 @@ def iv_refine(model, theta, channels, q_smooth, max_iter=10):
         z = instruments(model, th, q_smooth, s)
         g = z.T @ r
         # the wind rows: the gradient of the objective's GPS-noise spread term
-        a2 = slope(model, th[COEFS], ch.qci, ch.rho) ** 2
-        g[WIND_N] += 4.0 * ch.var_v * float(np.sum(a2 * (ch.vn - th[WIND_N])))
-        g[WIND_E] += 4.0 * ch.var_v * float(np.sum(a2 * (ch.ve - th[WIND_E])))
+        c, w = spread_weights(model, th, ch)
+        g[WIND_N] += c * float(np.sum(w * (ch.vn - th[WIND_N])))
+        g[WIND_E] += c * float(np.sum(w * (ch.ve - th[WIND_E])))
         try:
             step = np.linalg.solve(z.T @ s, g)
         except np.linalg.LinAlgError:

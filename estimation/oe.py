@@ -17,13 +17,25 @@ from dataclasses import dataclass
 import numpy as np
 
 from pitotcal.core import checks
+from pitotcal.core.airdata import GAMMA, mach_from_qc
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 from pitotcal.core.models import get_model
 from pitotcal.core.processes import solver_interrupts
+from pitotcal.core.units import R_AIR_JKGK
 
 from .covariance import ColoredCovariance, colored_covariance, plain_covariance
 from .iv import IV_WINDOW_S, iv_refine, smooth_in_time
-from .residual import flight_channels, ratio_columns, residual, residual_function, sensitivities
+from .residual import (
+    AIR_CHANNELS,
+    ReferenceAir,
+    flight_channels,
+    impact_pressure,
+    is_compressible,
+    ratio_columns,
+    residual,
+    residual_function,
+    sensitivities,
+)
 from .result import IdentificationResult
 from .unknowns import WIND_NAMES, theta_scales, to_reported
 
@@ -52,30 +64,32 @@ _CACHE_SIZE = 4
 NOISE_TERMS = ("c_eiv", "pen_a", "pen_b", "weight")
 
 
-def _data_names(has_vd):
-    return ("qci", "vn", "ve", "rho") + (("vd2",) if has_vd else ())
+def _data_names(has_vd, air_data="incompressible"):
+    return ("qci", "vn", "ve", *AIR_CHANNELS[air_data]) + (("vd2",) if has_vd else ())
 
 
-def objective_function(model, n, has_vd):
+def objective_function(model, n, has_vd, air_data="incompressible"):
     """The corrected-score objective J (`OutputErrorProblem` Notes) as a named ``ca.Function``.
 
     Returns
     -------
     casadi.Function
         ``objective(x, qci, vn, ve, rho[, vd2], c_eiv, pen_a, pen_b, weight) -> J``, x the
-        scaled unknowns theta / `theta_scales` (vd2 only when `has_vd`). `residual_function`
-        is inlined, so the graph stays whole-vector MX.
+        scaled unknowns theta / `theta_scales` (vd2 only when `has_vd`; ``pt, oat`` in place
+        of ``rho`` when `air_data` is "compressible"). `residual_function` is inlined, so the
+        graph stays whole-vector MX.
     """
     import casadi as ca
 
-    residual_fn = residual_function(model, n, has_vd)
+    residual_fn = residual_function(model, n, has_vd, air_data)
     x = ca.MX.sym("x", len(model.params) + 2)
-    data = {name: ca.MX.sym(name, n) for name in _data_names(has_vd)}
+    data = {name: ca.MX.sym(name, n) for name in _data_names(has_vd, air_data)}
     noise = {name: ca.MX.sym(name) for name in NOISE_TERMS}
     # element by element: a whole-vector x * DM(scales) made IPOPT's derivative functions
     # take 23 MB more at N = 1e6 (measured)
     theta = ca.vertcat(*(x[i] * scale for i, scale in enumerate(theta_scales(model))))
-    r, a, tas_sq = residual_fn.call([theta, data["qci"], data["vn"], data["ve"], data["rho"],
+    air = [data[name] for name in AIR_CHANNELS[air_data]]
+    r, a, tas_sq = residual_fn.call([theta, data["qci"], data["vn"], data["ve"], *air,
                                      data.get("vd2", 0.0), noise["c_eiv"]], True, False)
     spread = ca.dot(a * a, noise["pen_a"] * tas_sq - noise["pen_b"])
     objective = noise["weight"] * (ca.dot(r, r) - spread) / n
@@ -91,12 +105,12 @@ class _Built:
     build_s: float
 
 
-def _build_solver(model, n, has_vd, ipopt_options):
+def _build_solver(model, n, has_vd, ipopt_options, air_data="incompressible"):
     """IPOPT on `objective_function`: x the scaled unknowns, p its other inputs in order."""
     import casadi as ca
 
     t0 = time.perf_counter()
-    objective = objective_function(model, n, has_vd)
+    objective = objective_function(model, n, has_vd, air_data)
     args = objective.mx_in()
     nlp = {"x": args[0], "p": ca.vertcat(*args[1:]), "f": objective.call(args, True, False)[0]}
     opts = {"ipopt": dict(ipopt_options), "print_time": False}
@@ -150,6 +164,11 @@ class OutputErrorProblem:
         a_i = (1 - f(q_ci,i; k)) rho_i / 2,
 
     whose expectation over the GPS noise is the noise-free sum of squares plus a constant.
+    That is the incompressible problem (paper eq. 2). The compressible one replaces
+    rho/2 (V_t^2 - n sigma_v^2) by the isentropic q_c(V_t^2 - n sigma_v^2) of the measured total
+    pressure (or a reference static pressure) and a_i by the local slope
+    (1 - f) dq_c/dV_t^2 (`estimation.residual`); the curvature of q_c(V_t^2) leaves a bias
+    of about M^2/2 of the noise correction itself, negligible.
     w scales J to O(1) at the start. IPOPT uses the exact Hessian.
 
     Example
@@ -164,18 +183,19 @@ class OutputErrorProblem:
                               **checks.option_dict("ipopt_options", ipopt_options)}
         self._built = {}
 
-    def _build(self, n, has_vd):
+    def _build(self, n, has_vd, air_data="incompressible"):
         """The solver for flights of `n` samples, built once and cached."""
-        key = (n, has_vd)
+        key = (n, has_vd, air_data)
         if key not in self._built:
             if len(self._built) >= _CACHE_SIZE:
                 self._built.pop(next(iter(self._built)))
-            self._built[key] = _build_solver(self.model, n, has_vd, self.ipopt_options)
+            self._built[key] = _build_solver(self.model, n, has_vd, self.ipopt_options,
+                                             air_data)
             log.debug("built %s problem for N=%d in %.3f s", self.model.name, n,
                       self._built[key].build_s)
         return self._built[key]
 
-    def solve(self, flight, *, gps_noise_std_mps=None, start=None):
+    def solve(self, flight, *, gps_noise_std_mps=None, start=None, air_data="incompressible"):
         """Identify the coefficients and the wind from `flight`.
 
         Parameters
@@ -187,25 +207,29 @@ class OutputErrorProblem:
         start : ndarray, optional
             Start values (k..., wind_n_mps, wind_e_mps); the linear least-squares start
             (`start_values`) when None.
+        air_data : {"incompressible", "compressible", "reference"}
+            How q_c follows from V_t (`estimation.residual`): "compressible" from the
+            flight's `ps_pa` + q_ci and `oat_k`, "reference" from its `ps_ref_pa` and
+            `oat_k` (`estimation.identify` checks and chooses; both report "compressible").
 
         Returns
         -------
         IdentificationResult
             Every field filled; no observability checks here (`estimation.identify` does them).
         """
-        built = self._build(flight.n, flight.gps_vd_mps is not None)
+        built = self._build(flight.n, flight.gps_vd_mps is not None, air_data)
         timing = {"build": built.build_s}
         t0 = time.perf_counter()
-        ch = flight_channels(flight, gps_noise_std_mps)
+        ch = flight_channels(flight, gps_noise_std_mps, air_data)
         theta0 = (np.asarray(start, dtype=float) if start is not None
-                  else start_values(self.model, ch.qci, ch.vn, ch.ve, ch.rho, ch.vd2, ch.c_eiv))
+                  else start_values(self.model, ch.qci, ch.vn, ch.ve, ch.air, ch.vd2, ch.c_eiv))
         x_opt, p_val, weight, stats = _minimise(self.model, built, ch, theta0)
         timing["solve"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
         fit = _refine(self.model, built, x_opt, p_val, weight, ch, flight.time_s)
         timing["covariance"] = time.perf_counter() - t0
-        return _result(self.model, flight, ch, fit, stats, timing)
+        return _result(self.model, flight, ch, fit, stats, timing, air_data)
 
 
 def _minimise(model, built, ch, theta0):
@@ -217,6 +241,7 @@ def _minimise(model, built, ch, theta0):
     s0 = 1.4826 * np.median(np.abs(r0 - np.median(r0)))
     s0 = max(s0, 1e-6 * float(np.mean(ch.qci)), 1e-9)
     values = {"qci": ch.qci, "vn": ch.vn, "ve": ch.ve, "rho": ch.rho, "vd2": ch.vd2,
+              "pt": ch.pt, "oat": ch.oat, "ps_ref": ch.ps_ref,
               "c_eiv": ch.c_eiv, "pen_a": 4.0 * ch.var_v,
               "pen_b": 2.0 * ch.n_comp * ch.var_v ** 2, "weight": 1.0 / s0 ** 2}
     p_val = ca.DM(np.concatenate([np.atleast_1d(values[name]) for name in built.p_names]))
@@ -249,7 +274,7 @@ def _refine(model, built, x_opt, p_val, weight, ch, time_s):
     return _Fit(theta, residuals, cov_plain, colored, tuple(warn))
 
 
-def _result(model, flight, ch, fit, stats, timing):
+def _result(model, flight, ch, fit, stats, timing, air_data="incompressible"):
     """The `IdentificationResult` of a solve and its refinement."""
     params, cov = to_reported(fit.theta, fit.colored.covariance)
     _, cov_plain = to_reported(fit.theta, fit.covariance_plain)
@@ -278,6 +303,9 @@ def _result(model, flight, ch, fit, stats, timing):
         rho_kgm3=flight.rho_kgm3,
         residuals_pa=fit.residuals,
         warnings=warn,
+        air_data="incompressible" if air_data == "incompressible" else "compressible",
+        ps_pa=flight.ps_pa if air_data != "incompressible" else None,
+        ps_ref_pa=flight.ps_ref_pa if air_data == "reference" else None,
         timing_s=timing,
     )
 
@@ -297,18 +325,28 @@ def _information(hessian, x_opt, p_val, scales, n, weight, jac):
     return info
 
 
-def start_values(model, qci_pa, vn_mps, ve_mps, rho_kgm3, vd2=None, c_eiv=0.0):
+def start_values(model, qci_pa, vn_mps, ve_mps, air, vd2=None, c_eiv=0.0):
     """Start values (k..., wind_n_mps, wind_e_mps) by linear least squares, any wind.
+
+    Parameters
+    ----------
+    air : ndarray or (ndarray, ndarray)
+        Density rho, kg/m^3 (incompressible), or total pressure and static temperature
+        (p_T Pa, T_s K) (compressible; `estimation.residual`).
 
     Notes
     -----
     With c = 1 - k1 and a constant ratio, 2 q_ci / rho = c (|V_g|^2 - c_eiv) - 2 c V_g . W
     + c |W|^2 is linear in (c, c wind_n, c wind_e, c |W|^2): one least-squares solve gives the
     wind from any direction and speed (the problem is not convex in the wind direction, so a
-    start from the data matters). The remaining coefficients then come from a Gauss-Newton
+    start from the data matters). Compressible, the left side is the V_t^2 whose q_c is q_ci
+    (about (1 - k1) V_t^2 too). The remaining coefficients then come from a Gauss-Newton
     fit of the per-sample ratio 1 - q_ci / q_c(W) to the model.
     """
-    y = qci_pa / impact_pressure_pa(rho_kgm3, 1.0)          # (1 - f) V_t^2
+    if is_compressible(air):
+        y = _tas_sq_of_qc(qci_pa, air)                     # about (1 - f) V_t^2
+    else:
+        y = qci_pa / impact_pressure_pa(air, 1.0)          # (1 - f) V_t^2
     v2g = tas_squared(vn_mps, ve_mps, 0.0, 0.0, vd2) - c_eiv  # |V_g|^2 - c_eiv
     design = np.column_stack([v2g, -2.0 * vn_mps, -2.0 * ve_mps, np.ones_like(y)])
     colscale = np.sqrt(np.mean(design ** 2, axis=0))
@@ -318,7 +356,11 @@ def start_values(model, qci_pa, vn_mps, ve_mps, rho_kgm3, vd2=None, c_eiv=0.0):
     k = np.zeros(len(model.params))
     k[0] = 1.0 - c
     # Gauss-Newton on the ratio (exact in one step for models linear in k)
-    qc = impact_pressure_pa(rho_kgm3, tas_squared(vn_mps, ve_mps, wn, we, vd2) - c_eiv)
+    tas_sq = tas_squared(vn_mps, ve_mps, wn, we, vd2) - c_eiv
+    if is_compressible(air):
+        qc = impact_pressure(air, np.maximum(tas_sq, 0.0))[0]
+    else:
+        qc = impact_pressure_pa(air, tas_sq)
     ok = qc > 0
     ratio = 1.0 - qci_pa[ok] / qc[ok]
     q = qci_pa[ok]
@@ -327,6 +369,13 @@ def start_values(model, qci_pa, vn_mps, ve_mps, rho_kgm3, vd2=None, c_eiv=0.0):
                                rcond=None)[0]
         k = k + step
     return np.concatenate([k, [wn, we]])
+
+
+def _tas_sq_of_qc(qc_pa, air):
+    """V_t^2 whose impact pressure is q_c with the compressible air data `air`."""
+    ps = air.ps if isinstance(air, ReferenceAir) else air.pt - qc_pa
+    mach = mach_from_qc(qc_pa, ps)
+    return mach * np.abs(mach) * GAMMA * R_AIR_JKGK * air.oat
 
 
 def _gap_warning(time_s):

@@ -14,9 +14,20 @@ import math
 
 import numpy as np
 
+from pitotcal.core import airdata
 from pitotcal.core.models import get_model
-from pitotcal.core.units import RHO0_KGM3, cas_from_qc_mps, mps_to_kt
+from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, m_to_ft, mps_to_kt
 from pitotcal.io.jsonfile import json_ready
+
+from .static_source import (
+    air_data_lines,
+    plot_altimeter_correction,
+    plot_static_error,
+    pressure_altitude_ic_m,
+    static_source_products,
+    static_statement,
+    static_table_lines,
+)
 
 __all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary", "to_dict"]
 
@@ -25,13 +36,26 @@ _WIND_UNITS = {"wind_speed_mps": "m/s", "wind_from_deg": "deg"}
 _MAX_POINTS = 4000           # samples drawn as faint points: enough to see the cloud, cheap
 
 
+def _compressible(result):
+    return getattr(result, "air_data", "incompressible") == "compressible"
+
+
+def airspeed_kt(result, qc_pa):
+    """The airspeed of impact pressures, kt, by the result's law: the standard calibrated
+    airspeed (compressible) or sqrt(2 q / rho0) (incompressible)."""
+    if _compressible(result):
+        return mps_to_kt(airdata.cas_from_qc_mps(qc_pa))
+    return mps_to_kt(incompressible_cas_mps(qc_pa))
+
+
 def flown_vi_kt(result):
-    """(lowest, highest) indicated airspeed V_i = sqrt(2 q_ci / rho0) flown, kt."""
+    """(lowest, highest) indicated airspeed V_i flown, kt: sqrt(2 q_ci / rho0), or the
+    standard CAS of q_ci (V_ic) for a compressible result."""
     qci = np.asarray(result.qci_pa, dtype=float)
     qci = qci[np.isfinite(qci) & (qci > 0)]
     if qci.size == 0:
         raise ValueError("the result holds no positive q_ci samples")
-    vi = mps_to_kt(cas_from_qc_mps(np.array([qci.min(), qci.max()])))
+    vi = airspeed_kt(result, np.array([qci.min(), qci.max()]))
     return float(vi[0]), float(vi[1])
 
 
@@ -58,7 +82,10 @@ def correction_table(result, step_kt=None):
         Rows {vi_kt, dv_kt, dv_2sigma_kt, dv_2sigma_plain_kt, vc_kt}: indicated airspeed V_i,
         correction ΔV = V_c - V_i and its 2-sigma (corrected, and plain Hessian), calibrated
         V_c = V_i + ΔV, all kt. The first and last rows are the lowest and highest V_i flown
-        (rounded inward to 0.1 kt); between them the multiples of `step_kt`.
+        (rounded inward to 0.1 kt); between them the multiples of `step_kt`. A compressible
+        result's rows (V_i = V_ic, ΔV = ΔV_pc) add the static-source products of
+        `estimation.static_source`: mach_i, dmach, dmach_2sigma, dh_ft, dh_2sigma_ft,
+        dpp_qcic, dpp_qcic_2sigma.
     """
     lo, hi = flown_vi_kt(result)
     if step_kt is None:
@@ -72,10 +99,21 @@ def correction_table(result, step_kt=None):
     grid = np.unique(np.concatenate([[lo_r], inner[(inner > lo_r) & (inner < hi_r)], [hi_r]]))
     dv, band = result.delta_v_kt(grid)
     _, band_plain = result.delta_v_kt(grid, plain=True)
-    return [{"vi_kt": float(v), "dv_kt": float(d), "dv_2sigma_kt": float(b),
+    rows = [{"vi_kt": float(v), "dv_kt": float(d), "dv_2sigma_kt": float(b),
              "dv_2sigma_plain_kt": float(bp), "vc_kt": float(v + d)}
             for v, d, b, bp in zip(grid, np.atleast_1d(dv), np.atleast_1d(band),
                                    np.atleast_1d(band_plain))]
+    if _compressible(result) and result.ps_pa is not None:
+        extra = static_source_products(result, grid)
+        keys = _STATIC_KEYS + (_REFERENCE_KEYS if "dpt_qcic" in extra else ())
+        for i, row in enumerate(rows):
+            row.update({key: float(np.atleast_1d(extra[key])[i]) for key in keys})
+    return rows
+
+
+_STATIC_KEYS = ("mach_i", "dmach", "dmach_2sigma", "dh_ft", "dh_2sigma_ft", "dpp_qcic",
+                "dpp_qcic_2sigma")
+_REFERENCE_KEYS = ("dpt_qcic", "dpt_qcic_2sigma")
 
 
 def to_dict(result):
@@ -114,7 +152,16 @@ def to_dict(result):
         "candidates": list(result.candidates),
         "criterion": result.criterion,
         "timing_s": dict(result.timing_s),
+        "air_data": result.air_data,
     }
+    if _compressible(result):
+        h_ic = pressure_altitude_ic_m(result)
+        statement, fit = static_statement(result)
+        out["static_source"] = {
+            "assumed": statement,
+            "pressure_altitude_ic_ft": None if h_ic is None else float(m_to_ft(h_ic))}
+        if fit is not None:
+            out["static_source"]["k_static"] = fit
     return json_ready(out)
 
 
@@ -162,13 +209,20 @@ def summary(result):
         (f"  {'wind from':<14}{f'{frm:.1f}°':>12}{'±' + _fmt(frm2, 2) + '°':>12}"
          f"{'(±' + _fmt(frm2p, 2) + '°)':>14}   true, the direction it blows from"),
         "",
+    ]
+    table = correction_table(result)
+    if _compressible(result):
+        lines += air_data_lines(result)
+    lines += [
         "Airspeed correction, ΔV = V_c - V_i (add ΔV to the indicated airspeed):",
         f"  {'KIAS':>7}{'ΔV kt':>9}{'±2σ kt':>9}{'(plain)':>9}{'KCAS':>8}",
     ]
-    for row in correction_table(result):
+    for row in table:
         lines.append(f"  {row['vi_kt']:7.1f}{row['dv_kt']:+9.2f}{row['dv_2sigma_kt']:9.2f}"
                      f"{'(' + format(row['dv_2sigma_plain_kt'], '.2f') + ')':>9}"
                      f"{row['vc_kt']:8.1f}")
+    if table and "dh_ft" in table[0]:
+        lines += static_table_lines(result, table)
     if result.candidates:
         crit = result.criterion or "criterion"
         lines += ["", f"Candidate structures ({crit}; lowest chosen):"]
@@ -208,7 +262,9 @@ def plot(result, path=None):
 
     Four panels: ΔV vs V_i with the 2-sigma band (plain Hessian band dashed); Δp/q_c vs q_ci
     with its band and the per-sample ratio implied by the residuals as faint points; the
-    q_ci distribution; the residual time history. The wind is in the title.
+    q_ci distribution; the residual time history. The wind is in the title. A compressible
+    result shows Δp_p/q_cic vs M_ic and ΔH_pc vs V_ic (`estimation.static_source`) in place
+    of the second and third.
 
     Parameters
     ----------
@@ -225,12 +281,19 @@ def plot(result, path=None):
     fig = Figure(figsize=(12, 8.5), layout="constrained")
     ax_dv, ax_dp, ax_hist, ax_res = fig.subplots(2, 2).ravel()
     _plot_correction(ax_dv, result)
-    _plot_pressure_error(ax_dp, result)
-    _plot_distribution(ax_hist, result)
+    if _compressible(result) and result.ps_pa is not None:
+        # the static-source products in place of Δp/q_c vs q_ci and the q_ci histogram
+        g = _implied_ratio(result, get_model(result.model))[1]
+        plot_static_error(ax_dp, result, g, flown_vi_kt(result))
+        plot_altimeter_correction(ax_hist, result, flown_vi_kt(result))
+    else:
+        _plot_pressure_error(ax_dp, result)
+        _plot_distribution(ax_hist, result)
     _plot_residuals(ax_res, result)
     spd, spd2, _, frm, frm2, _ = _wind(result)
     state = "" if result.converged else "   [SOLVER DID NOT CONVERGE]"
-    fig.suptitle(f"{result.model} model, {result.n_samples} samples — wind {spd:.1f} ± {spd2:.1f}"
+    air = " (compressible, V_i = V_ic)" if _compressible(result) else ""
+    fig.suptitle(f"{result.model} model{air}, {result.n_samples} samples — wind {spd:.1f} ± {spd2:.1f}"
                  f" kt from {frm:.0f}° ± {frm2:.1f}° (2σ){state}", fontsize=13)
     if path is not None:
         fig.savefig(path, dpi=110)
@@ -290,7 +353,7 @@ def _plot_distribution(ax, result):
     ax.set_xlim(max(0.0, q_lo - margin), q_hi + margin)
     ax.set(xlabel="q_ci (Pa)", ylabel="samples", title="Data distribution")
     ax_v = ax.secondary_xaxis(
-        "top", functions=(lambda q: mps_to_kt(cas_from_qc_mps(q)),
+        "top", functions=(lambda q: mps_to_kt(incompressible_cas_mps(q)),
                           lambda v: 0.5 * RHO0_KGM3 * (np.asarray(v) / mps_to_kt(1.0)) ** 2))
     ax_v.set_xlabel("V_i (kt)")
 

@@ -6,6 +6,8 @@ import numpy as np
 
 from pitotcal.core.models import delta_v_kt, get_model
 
+from .propagation import band as _band
+from .propagation import gradient as _gradient
 from .unknowns import COEFS
 
 __all__ = ["IdentificationResult"]
@@ -47,6 +49,17 @@ class IdentificationResult:
         The information criterion used to choose among candidates.
     timing_s : dict
         Seconds spent in `build`, `solve`, `covariance`.
+    air_data : {"incompressible", "compressible"}
+        How q_c was predicted from V_t (`estimation.identify`, `air`), and so which airspeed
+        law the correction table uses: sqrt(2 q / rho0), or the standard calibrated airspeed
+        (V_i is then V_ic and ΔV the position-error correction ΔV_pc).
+    ps_pa : ndarray, shape (N,), or None
+        The static source's pressure used (compressible only): sets the flight's pressure
+        altitude for the altimeter correction.
+    ps_ref_pa : ndarray, shape (N,), or None
+        The flight's independent reference static pressure, when it had one (compressible):
+        the prediction used it, and it separates static from total pressure error
+        (`estimation.static_source`).
     """
 
     model: str
@@ -71,6 +84,9 @@ class IdentificationResult:
     candidates: tuple = ()
     criterion: str | None = None
     timing_s: dict = field(default_factory=dict)
+    air_data: str = "incompressible"
+    ps_pa: np.ndarray | None = None
+    ps_ref_pa: np.ndarray | None = None
 
     # --- derived quantities -------------------------------------------------------------
     @property
@@ -116,12 +132,15 @@ class IdentificationResult:
     def delta_v_kt(self, vi_kt, plain=False):
         """Airspeed correction ΔV = V_c - V_i (kt) at indicated `vi_kt` and its 2-sigma half-width.
 
-        V_i = sqrt(2 q_ci / rho0), V_c = sqrt(2 q_c / rho0), q_c = q_ci / (1 - f(q_ci)).
+        q_c = q_ci / (1 - f(q_ci)); V_i and V_c are the airspeeds of q_ci and q_c by the law of
+        `air_data` (`pitotcal.core.models.delta_v_kt`): sqrt(2 q / rho0), or the standard
+        calibrated airspeed (ΔV = ΔV_pc, V_i = V_ic).
         """
         model = get_model(self.model)
         k = self.coefficients
-        grad = _gradient(lambda kk: delta_v_kt(model, kk, vi_kt), k)
-        return delta_v_kt(model, k, vi_kt), 2.0 * _band(grad, self._coef_cov(plain))
+        grad = _gradient(lambda kk: delta_v_kt(model, kk, vi_kt, self.air_data), k)
+        return (delta_v_kt(model, k, vi_kt, self.air_data),
+                2.0 * _band(grad, self._coef_cov(plain)))
 
     # --- presentation (estimation/report.py) --------------------------------------------
     def summary(self):
@@ -147,21 +166,3 @@ class IdentificationResult:
     def _coef_cov(self, plain):
         cov = self.internal_covariance_plain if plain else self.internal_covariance
         return cov[COEFS, COEFS]
-
-
-def _gradient(fun, k):
-    """Central-difference gradient of a vector function of the coefficients, shape (len(k), ...)."""
-    k = np.asarray(k, dtype=float)
-    rows = []
-    for i in range(k.size):
-        h = 1e-6 * max(1.0, abs(k[i]))
-        up, dn = k.copy(), k.copy()
-        up[i] += h
-        dn[i] -= h
-        rows.append((fun(up) - fun(dn)) / (2 * h))
-    return np.array(rows)
-
-
-def _band(grad, cov):
-    """One-sigma of a derived quantity: sqrt(g^T C g) for each column of `grad`."""
-    return np.sqrt(np.maximum(np.einsum("i...,ij,j...->...", grad, cov, grad), 0.0))

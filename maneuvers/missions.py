@@ -26,9 +26,9 @@ from pitotcal.core.plan import Plan
 from pitotcal.core.scenario import CAS_TOLERANCE_KT
 from pitotcal.core.units import (
     G0_MPS2,
-    cas_from_qc_mps,
+    incompressible_cas_mps,
+    incompressible_qc_pa,
     mps_to_kt,
-    qc_from_cas_pa,
     wind_vector_mps,
 )
 from pitotcal.io.mission_files import (
@@ -110,7 +110,7 @@ def _stepped_levels(plan):
         at = np.flatnonzero(np.isclose(plan.qc_pa, q, rtol=1e-6, atol=1e-3))
         ends.append(plan.time_s[at[-1]])
     bounds = [plan.time_s[0], *ends, plan.time_s[-1]]
-    return tuple(float(cas_from_qc_mps(q)) for q in levels), _whole_seconds(bounds), None
+    return tuple(float(incompressible_cas_mps(q)) for q in levels), _whole_seconds(bounds), None
 
 
 def _staircase(plan, n):
@@ -119,8 +119,8 @@ def _staircase(plan, n):
     t = plan.time_s
     bounds = np.linspace(t[0], t[-1], n + 1)
     q_mid = np.interp(0.5 * (bounds[1:] + bounds[:-1]), t, plan.qc_pa)
-    cas = cas_from_qc_mps(q_mid)
-    cas_edges = cas_from_qc_mps(np.interp(bounds, t, plan.qc_pa))
+    cas = incompressible_cas_mps(q_mid)
+    cas_edges = incompressible_cas_mps(np.interp(bounds, t, plan.qc_pa))
     error = np.maximum(np.abs(cas_edges[:-1] - cas), np.abs(cas_edges[1:] - cas))
     return cas, bounds, float(mps_to_kt(error.max()))
 
@@ -362,5 +362,5 @@ def loiter_plan(plan, mission, *, start_deg=0.0):
     return Plan(time_s=t.copy(), north_m=radius * np.cos(bearing),
                 east_m=radius * np.sin(bearing), alt_m=plan.alt_m.copy(),
                 heading_deg=np.degrees(heading), bank_deg=np.degrees(bank), tas_mps=tas,
-                cas_mps=cas, qc_pa=qc_from_cas_pa(cas), settings=dict(s),
+                cas_mps=cas, qc_pa=incompressible_qc_pa(cas), settings=dict(s),
                 message="loiter flown by an autopilot")

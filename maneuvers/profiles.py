@@ -19,7 +19,12 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import PROFILES
-from pitotcal.core.units import RHO0_KGM3, cas_from_qc_mps, isa_density_kgm3, qc_from_cas_pa
+from pitotcal.core.units import (
+    RHO0_KGM3,
+    incompressible_cas_mps,
+    incompressible_qc_pa,
+    isa_density_kgm3,
+)
 
 __all__ = ["PROFILES", "Schedule", "coverage_groups", "make_schedule"]
 
@@ -131,7 +136,7 @@ def _stepped_q(q_range, levels, duration_s, tas_per_cas, accel_max_mps2, dt_s):
     if n_levels < 2:
         raise PitotcalError(f"levels {levels} must be at least 2", param="levels")
     level_q = q_min + (q_max - q_min) * np.arange(n_levels) / (n_levels - 1)
-    level_tas = cas_from_qc_mps(level_q) * tas_per_cas
+    level_tas = incompressible_cas_mps(level_q) * tas_per_cas
     ramps = np.diff(level_tas) / accel_max_mps2
     dwell = (duration_s - ramps.sum()) / n_levels
     # a dwell shorter than one node spacing is no dwell at all
@@ -154,7 +159,7 @@ def _stepped_q(q_range, levels, duration_s, tas_per_cas, accel_max_mps2, dt_s):
             qc[node:node + count] = level_q[seg]
         else:                    # ramp: TAS linear in time at the acceleration limit
             tas = np.linspace(level_tas[seg], level_tas[seg + 1], count + 1)[1:]
-            qc[node:node + count] = qc_from_cas_pa(tas / tas_per_cas)
+            qc[node:node + count] = incompressible_qc_pa(tas / tas_per_cas)
         node += count
     return time_s, qc, tuple(float(v) for v in level_q)
 
@@ -208,7 +213,7 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
                             param="profile")
     rho = float(isa_density_kgm3(altitude_m))
     tas_per_cas = np.sqrt(RHO0_KGM3 / rho)
-    q_range = (float(qc_from_cas_pa(cas_min_mps)), float(qc_from_cas_pa(cas_max_mps)))
+    q_range = (float(incompressible_qc_pa(cas_min_mps)), float(incompressible_qc_pa(cas_max_mps)))
     if profile == "continuous":
         time_s, qc = _continuous_q(q_range, cas_min_mps, duration_s, tas_per_cas,
                                    accel_max_mps2, dt_s, return_leg)
@@ -216,7 +221,7 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
     else:
         time_s, qc, level_q = _stepped_q(q_range, 2 if profile == "two-speed" else levels,
                                          duration_s, tas_per_cas, accel_max_mps2, dt_s)
-    cas = cas_from_qc_mps(qc)
+    cas = incompressible_cas_mps(qc)
     tas = cas * tas_per_cas
     accel = np.diff(tas) / np.diff(time_s)
     if len(level_q) == 2:

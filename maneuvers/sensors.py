@@ -146,7 +146,7 @@ def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, la
     return vel[held] + noise[held]
 
 
-def air_records(time_s, states, air_data, sensors):
+def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
     """The air-data truth and records of `AirSensors` (issue 9): (q_c, logged ρ, columns).
 
     Parameters
@@ -156,6 +156,9 @@ def air_records(time_s, states, air_data, sensors):
         The simulator's states (north, east, alt, heading, tas, bank, wind n, wind e).
     air_data : {"incompressible", "compressible"}
     sensors : maneuvers.sim_options.AirSensors
+    model, k :
+        The true pressure-error model: with compressible air data the static port reads
+        p_s + Δp_p, Δp_p = q_c − q_ci (all the error in the static source, as `simulate`).
 
     Returns
     -------
@@ -165,7 +168,8 @@ def air_records(time_s, states, air_data, sensors):
     rho_kgm3 : ndarray (N,)
         The density a logger computes from what it logs, p_s / (R T_logged), dry air.
     columns : dict
-        Flight fields: `ps_pa` (ISA, exact), `oat_k` or `tat_k` (with bias), `rh_pct` if humid.
+        Flight fields: `ps_pa` (as the static port reads it), `oat_k` or `tat_k` (with bias),
+        `rh_pct` if humid.
     """
     from pitotcal.core.airdata import mach_from_tas, qc_from_tas_sq_pa
     from pitotcal.core.moist_air import virtual_temperature_k
@@ -180,7 +184,12 @@ def air_records(time_s, states, air_data, sensors):
         qc = qc_from_tas_sq_pa(v_probe ** 2, ps, tv)
     else:
         qc = 0.5 * ps / (R_AIR_JKGK * tv) * v_probe ** 2
-    columns = {"ps_pa": ps}
+    ps_read = ps
+    if air_data == "compressible":
+        m = get_model(model)
+        k = true_k(model) if k is None else k
+        ps_read = ps + qc - qci_from_qc_pa(m, tuple(k[:len(m.params)]), qc)
+    columns = {"ps_pa": ps_read}
     if sensors.tat_recovery is None:
         logged_t = columns["oat_k"] = ts + sensors.oat_bias_k
     else:
@@ -189,4 +198,4 @@ def air_records(time_s, states, air_data, sensors):
                                        + sensors.oat_bias_k)
     if sensors.rh_pct > 0:
         columns["rh_pct"] = np.full(alt.size, sensors.rh_pct)
-    return qc, ps / (R_AIR_JKGK * logged_t), columns
+    return qc, ps_read / (R_AIR_JKGK * logged_t), columns

@@ -38,7 +38,7 @@ from pitotcal.core.checks import integer
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.flight import Flight
 from pitotcal.core.measurement import impact_pressure_pa
-from pitotcal.core.models import get_model
+from pitotcal.core.models import get_model, qci_from_qc_pa
 from pitotcal.core.units import (
     G0_MPS2,
     RHO0_KGM3,
@@ -190,14 +190,22 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
     _, _, alt, psi, tas, _, wn, we = states.T
     dt, n = 1.0 / opts.rate_hz, t.size
     rho = isa_density_kgm3(alt)
+    static = {}
     if opts.air_data == "compressible":
-        # isentropic, at the ISA static pressure and temperature rho is made of
-        qc = qc_from_tas_sq_pa(tas ** 2, isa_pressure_pa(alt), isa_temperature_k(alt))
+        # isentropic, at the ISA static pressure and temperature rho is made of; the static
+        # port reads p_s + Δp_p with all the pressure error in the static source (the pitot's
+        # total pressure exact), Δp_p = q_c − q_ci at the probe, before the transducer
+        ps, oat = isa_pressure_pa(alt), isa_temperature_k(alt)
+        qc = qc_from_tas_sq_pa(tas ** 2, ps, oat)
+        model = get_model(opts.model)
+        dp = qc - qci_from_qc_pa(model, tuple(opts.k[:len(model.params)]), qc)
+        static = {"ps_pa": ps + dp, "oat_k": oat}
     else:
         qc = impact_pressure_pa(rho, tas ** 2)
     air = {}
     if opts.air_sensors is not None:      # issue 9 item 7: temperature, humidity, probe arm
-        qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors)
+        qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
+                                   opts.k)
     climb = np.gradient(alt, dt) if n > 1 else np.zeros(n)
     vel = np.column_stack([tas * np.cos(psi) + wn, tas * np.sin(psi) + we, -climb])
     qci = impact_pressure_sensor(qc, dt, rng_qc, model=opts.model, k=opts.k,
@@ -216,7 +224,7 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
         meta["air_data"] = opts.air_data
     flight = Flight(time_s=t, qci_pa=qci, gps_vn_mps=gps[:, 0], gps_ve_mps=gps[:, 1],
                     rho_kgm3=rho, gps_vd_mps=gps[:, 2], alt_m=alt,
-                    source=f"simulate(seed={seed})", meta=meta, **air)
+                    source=f"simulate(seed={seed})", meta=meta, **(air or static))
     return flight, qc, vel
 
 
@@ -306,7 +314,8 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         True impact pressure from the true airspeed: ½ρV_t² (the paper's eq. 2, the default)
         or isentropic, q_c = p_s[(1 + 0.2M²)^3.5 − 1] with the ISA static pressure and
         temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
-        The autopilot flies the plan's true airspeed either way.
+        Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
+        `oat_k`. The autopilot flies the plan's true airspeed either way.
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -314,8 +323,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     keep_history : bool
         Also return the true time histories as numpy arrays in truth.history (not written
         by `write_truth_json`).
-    air_sensors : maneuvers.sim_options.AirSensors or dict, optional
-        TAT probe, humidity, probe arm, OAT/GPS biases (issue 9); None: records as before.
+    air_sensors : maneuvers.sim_options.AirSensors or dict, optional (issue 9; None: as before)
 
     Returns
     -------

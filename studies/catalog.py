@@ -18,6 +18,7 @@ from pitotcal.io.jsonfile import write_json
 from .budget_study import STUDY as BUDGET
 from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
+from .legs_study import STUDY as LEGS
 from .maneuvers_study import STUDY as MANEUVERS
 from .real_alfa import STUDY as REAL_ALFA
 from .runner import RunsInterrupted, count_errors, output_folder, write_table
@@ -32,7 +33,7 @@ log = logging.getLogger(__name__)
 
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
-                               PEERS, BUDGET)}
+                               PEERS, LEGS, BUDGET)}
 
 
 class StudyInterrupted(KeyboardInterrupt):

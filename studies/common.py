@@ -14,7 +14,7 @@ import numpy as np
 from pitotcal.core.checks import wrap_deg
 from pitotcal.core.models import delta_v_kt, get_model
 from pitotcal.core.scenario import T2_PLAN
-from pitotcal.core.units import cas_from_qc_mps, mps_to_kt, wind_polar
+from pitotcal.core.units import incompressible_cas_mps, mps_to_kt, wind_polar
 
 __all__ = [
     "N_DV_GRID",
@@ -125,7 +125,7 @@ def truth_delta_v_kt(truth, vi_kt):
 
 def vi_grid_kt(qci_pa, n=N_DV_GRID):
     """`n` indicated airspeeds (kt) spanning the 2-98 % range of the impact pressures flown."""
-    vi_kt = mps_to_kt(cas_from_qc_mps(np.maximum(qci_pa, 0.0)))
+    vi_kt = mps_to_kt(incompressible_cas_mps(np.maximum(qci_pa, 0.0)))
     lo, hi = np.percentile(vi_kt, [2.0, 98.0])
     return np.linspace(lo, hi, n)
 

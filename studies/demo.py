@@ -3,7 +3,8 @@
 Plan the continuous 70-100 KCAS maneuver (0.5 nm = 926 m radius, 800 ft = 244 m, 240 s, 30°
 bank, 5 m/s wind from 270°), fly it in the simulator (light turbulence, realistic sensors: 50 Hz
 transducer with 0.5 Pa noise, 5 Hz GPS with 0.05 m/s noise), identify the inverse+ model and
-the wind, and write everything into one folder.
+the wind, and write everything into one folder, ending with the calibration report (the
+deliverable, `pitotcal report`) made from the result just identified.
 """
 
 import logging
@@ -39,14 +40,14 @@ class DemoResult:
     out_dir : Path
     files : dict
         Role -> path: ``plan_csv``, ``flight_csv``, ``truth_json``, ``result_json``,
-        ``plan_png``, ``calibration_png``, ``residuals_png``.
+        ``plan_png``, ``calibration_png``, ``residuals_png``, ``report_html`` (last).
     table : list of dict
         Rows {vi_kt, dv_kt, dv_2sigma_kt, dv_true_kt} over the flown range.
     result : pitotcal.IdentificationResult
     truth : pitotcal.maneuvers.truth.Truth
         The simulator's truth.
     timing_s : dict
-        Seconds spent planning, simulating, identifying and writing.
+        Seconds spent planning, simulating, identifying, writing and making the report.
     """
 
     out_dir: Path
@@ -111,6 +112,9 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     result.plot(files["calibration_png"])
     files["residuals_png"] = _residual_figure(result, out)
     clock["write"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    files["report_html"] = _report(result, flight, files, out)
+    clock["report"] = time.perf_counter() - t0
     return DemoResult(out, {k: Path(v) for k, v in files.items()}, table, result, truth,
                       {k: round(v, 3) for k, v in clock.items()})
 
@@ -138,6 +142,23 @@ def format_table(table, every_kt=5.0):
         lines.append(f"  {row['vi_kt']:6.1f}   {row['dv_kt']:+6.3f}   {row['dv_2sigma_kt']:6.3f}"
                      f"   {row['dv_true_kt']:+11.3f}   {'yes' if inside else 'NO':>10}")
     return "\n".join(lines)
+
+
+def _report(result, flight, files, out):
+    """The calibration report of the result just identified (no second identification)."""
+    import json
+
+    from pitotcal.estimation.calibration_report import build_report, render_html
+
+    doc = json.loads(files["result_json"].read_text())
+    options = {"command": "pitotcal demo", "regulation": "23.1323",
+               "speed_range_kt": "flown range"}
+    context = build_report(doc, flight=flight, ident=result, options=options,
+                           inputs=[("Result JSON", files["result_json"]),
+                                   ("Flight", files["flight_csv"])])
+    path = out / "report.html"
+    path.write_text(render_html(context), encoding="utf-8")
+    return path
 
 
 def _plan_figure(plan, out):

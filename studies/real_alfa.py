@@ -22,7 +22,7 @@ import numpy as np
 
 from pitotcal.core.checks import wrap_deg
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.units import cas_from_qc_mps, mps_to_kt, wind_polar
+from pitotcal.core.units import incompressible_cas_mps, mps_to_kt, wind_polar
 from pitotcal.io.alfa import find_alfa_data, read_alfa_csv, read_alfa_flight
 
 from .baselines import ardupilot_ratio_from_k1, k1_from_ardupilot_ratio
@@ -67,7 +67,7 @@ def analyse_real_flight(data_dir, oat="autopilot"):
     d = Path(data_dir)
     flight = read_alfa_flight(d, oat=oat)
     seg = (float(flight.time_s[0]), float(flight.time_s[-1]))
-    vi_kt = mps_to_kt(cas_from_qc_mps(flight.qci_pa))
+    vi_kt = mps_to_kt(incompressible_cas_mps(flight.qci_pa))
     vi_ref_kt = float(np.median(vi_kt))
     ours = {model: _calibrate(flight, model, vi_ref_kt) for model in MODELS}
     ap = _autopilot_tracks(d, float(flight.meta["t0_unix_s"]))

@@ -97,8 +97,9 @@ def test_identify_on_a_log_takes_the_oat(tmp_path, flight, capsys):
     """--oat-c reaches the log reader (no sensor-temperature warning, density from it)."""
     log = write_dataflash_bin(tmp_path / "f.bin", flight, gps_invalid=(50.0, 60.0))
     out = tmp_path / "r.json"
+    # the synthetic truth is q_c = rho V^2 / 2: fitted with that relation
     assert main(["identify", str(log), "--model", "constant", "--oat-c", "20",
-                 "--json", str(out)]) == 0
+                 "--air", "incompressible", "--json", str(out)]) == 0
     cap = capsys.readouterr()
     assert cap.err == "" and "samples cut)" in cap.out.splitlines()[0]
     d = json.loads(out.read_text())

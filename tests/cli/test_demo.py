@@ -10,7 +10,7 @@ import pytest
 from pitotcal.cli import main
 
 FILES = {"plan.csv", "flight.csv", "flight.truth.json", "result.json", "plan.png",
-         "calibration.png", "residuals.png"}
+         "calibration.png", "residuals.png", "report.html"}
 
 
 def test_short_demo_prints_table_and_files(tmp_path, capsys):
@@ -26,6 +26,8 @@ def test_short_demo_prints_table_and_files(tmp_path, capsys):
     assert f"wrote into {out_dir}/:" in out
     assert FILES == {p.name for p in out_dir.iterdir()}
     assert {line.split()[0] for line in out[out.index(f"wrote into {out_dir}/:") + 1:]} == FILES
+    assert out[-1].split()[0] == "report.html"          # the demo ends with the report
+    assert "Compliance" in (out_dir / "report.html").read_text()
 
 
 NOT_A_FOLDER = "--out must be a folder (it receives the plan, flight, result and figures); " \

@@ -180,7 +180,7 @@ def incompressible_bias_kt(cas_kt, alt_ft):
     qc = ad.qc_from_cas_pa(np.asarray(cas_kt) * KT)
     tas = ad.mach_from_qc(qc, ps) * ad.speed_of_sound_mps(oat)
     eas = tas * np.sqrt(units.density_kgm3(ps, oat) / units.RHO0_KGM3)
-    return (eas - units.cas_from_qc_mps(qc)) / KT, tas / KT
+    return (eas - units.incompressible_cas_mps(qc)) / KT, tas / KT
 
 
 def test_incompressible_bias_of_a_perfect_system():
@@ -195,3 +195,33 @@ def test_incompressible_bias_of_a_perfect_system():
         assert incompressible_bias_kt(cas, alt)[0] == pytest.approx(expected, abs=0.006)
     # a UAV at 20 m/s at sea level: −0.017 kt, negligible
     assert incompressible_bias_kt(20.0 / KT, 0.0)[0] == pytest.approx(-0.0168, abs=1e-4)
+
+
+def test_qc_from_total_pressure_is_the_isentropic_relation():
+    """q_c from V_t and the total pressure p_T = p_s + q_c (the calibration's prediction)
+    equals q_c from V_t and p_s; its derivatives match central differences; CasADi agrees."""
+    tas = np.array([30.0, 100.0, 200.0])
+    ps, oat = np.array([101325.0, 75000.0, 50000.0]), np.array([288.15, 268.0, 250.0])
+    qc = ad.qc_from_tas_pa(tas, ps, oat)
+    np.testing.assert_allclose(ad.qc_from_total_pa(tas ** 2, ps + qc, oat), qc, rtol=1e-12)
+    d1, d2 = ad.qc_from_total_derivatives(tas ** 2, ps + qc, oat)
+    h = 1.0
+    up, dn = (ad.qc_from_total_pa(tas ** 2 + s, ps + qc, oat) for s in (h, -h))
+    np.testing.assert_allclose(d1, (up - dn) / (2 * h), rtol=1e-7)
+    up, dn = (ad.qc_from_total_derivatives(tas ** 2 + s, ps + qc, oat)[0] for s in (h, -h))
+    np.testing.assert_allclose(d2, (up - dn) / (2 * h), rtol=1e-6)
+    s1, s2 = ad.qc_from_tas_sq_derivatives(tas ** 2, ps, oat)      # at fixed p_s instead
+    up, dn = (ad.qc_from_tas_sq_pa(tas ** 2 + s, ps, oat) for s in (h, -h))
+    np.testing.assert_allclose(s1, (up - dn) / (2 * h), rtol=1e-7)
+    up, dn = (ad.qc_from_tas_sq_derivatives(tas ** 2 + s, ps, oat)[0] for s in (h, -h))
+    np.testing.assert_allclose(s2, (up - dn) / (2 * h), rtol=1e-6)
+    # the low-speed limit is the paper's eq. 2 with rho = p_T / (R T_s), less 0.9 M^2
+    mach = ad.mach_from_tas(tas[0], oat[0])
+    rho_t = (ps[0] + qc[0]) / (units.R_AIR_JKGK * oat[0])
+    assert d1[0] == pytest.approx(0.5 * rho_t * (1 - 0.9 * mach ** 2), rel=1e-4)
+    x, p, t = ca.SX.sym("x"), ca.SX.sym("p"), ca.SX.sym("t")
+    fn = ca.Function("q", [x, p, t], [ad.qc_from_total_pa(x, p, t, ca),
+                                      *ad.qc_from_total_derivatives(x, p, t, ca)])
+    for i in range(tas.size):
+        got = [float(v) for v in fn(tas[i] ** 2, ps[i] + qc[i], oat[i])]
+        np.testing.assert_allclose(got, [qc[i], d1[i], d2[i]], rtol=1e-12)

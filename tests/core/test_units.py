@@ -16,9 +16,9 @@ from pitotcal.core import units
     (units.isa_pressure_pa, 0.0, 101325.0),
     (units.isa_pressure_pa, 1000.0, 89874.6),       # ICAO standard atmosphere table
     (units.isa_density_kgm3, 1000.0, 1.11164),
-    (units.qc_from_cas_pa, 50.0, 1531.25),          # rho0 / 2 * 50^2
-    (units.cas_from_qc_mps, 1531.25, 50.0),
-    (units.cas_from_qc_mps, -1531.25, -50.0),       # sign kept: a curve continuous through 0
+    (units.incompressible_qc_pa, 50.0, 1531.25),          # rho0 / 2 * 50^2
+    (units.incompressible_cas_mps, 1531.25, 50.0),
+    (units.incompressible_cas_mps, -1531.25, -50.0),       # sign kept: a curve continuous through 0
 ])
 def test_conversions(fn, value, expected):
     args = value if isinstance(value, tuple) else (value,)

@@ -11,7 +11,7 @@ from pitotcal.estimation import identify
 from synthetic import synthetic_flight, with_ground_rolls
 
 from pitotcal.core.errors import FlightDataError, PitotcalError
-from pitotcal.core.units import RHO0_KGM3, cas_from_qc_mps
+from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps
 from pitotcal.io.airborne import gate_ends
 from pitotcal.io.logs import load_log, read_log
 from pitotcal.io.timebase import onto as _onto
@@ -57,7 +57,7 @@ def test_reader_recovers_written_flight_and_calibration(kind, tmp_path, truth_fl
     np.testing.assert_allclose(got.gps_vn_mps, np.interp(got.time_s - offset, flight.time_s,
                                                          flight.gps_vn_mps), atol=0.01)
     assert got.gps_vd_mps is not None and got.n >= flight.n - 2
-    result = identify(got, "inverse")
+    result = identify(got, "inverse", air="incompressible")   # the truth is q_c = rho V^2 / 2
     p = truth["parameters"]
     assert result.value("k1") == pytest.approx(p["k1"], abs=2e-3)
     assert result.value("k2") == pytest.approx(p["k2"], abs=1.5)
@@ -143,9 +143,9 @@ def test_ground_and_rolls_are_cut_on_the_autopilot_state_and_gate(kind, tmp_path
     got = flog.flight
     offset = 0.1 if kind.startswith("ulog") else 0.0       # the ULog header starts 0.1 s early
     t = flight.time_s
-    fast = t[np.flatnonzero(cas_from_qc_mps(flight.qci_pa) >= GATE_MPS)[[0, -1]]]
+    fast = t[np.flatnonzero(incompressible_cas_mps(flight.qci_pa) >= GATE_MPS)[[0, -1]]]
     np.testing.assert_allclose(got.time_s[[0, -1]], fast + offset, atol=0.11)
-    assert cas_from_qc_mps(got.qci_pa[[0, -1]]).min() >= GATE_MPS
+    assert incompressible_cas_mps(got.qci_pa[[0, -1]]).min() >= GATE_MPS
     state = f"autopilot not flying ({STATE_SOURCE[kind]})"
     gate = f"take-off or landing: IAS < 30 m/s ({PARAM[kind]})"
     assert list(flog.excluded)[:2] == [state, gate]
@@ -280,7 +280,7 @@ def test_sitl_dataflash_calibrates_end_to_end(shared_data):
                              "take-off or landing: IAS < 10 m/s (ARSPD_FBW_MIN)": 224}
     t = flog.flight.time_s
     assert t[0] == pytest.approx(15.5, abs=0.05) and t[-1] == pytest.approx(220.2, abs=0.05)
-    assert 9.8 < cas_from_qc_mps(flog.flight.qci_pa).min() < 10.0
+    assert 9.8 < incompressible_cas_mps(flog.flight.qci_pa).min() < 10.0
     result = identify(flog.flight, "constant")
     assert result.success and result.value("wind_speed_mps") < 1.0
     ratio = 2.0 / (RHO0_KGM3 * (1.0 - result.value("k1")))

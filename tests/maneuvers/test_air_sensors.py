@@ -15,7 +15,7 @@ from pitotcal.maneuvers.truth import write_truth_json
 from plans import circle_plan
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.moist_air import moist_density_kgm3
+from pitotcal.core.moist_air import moist_density_kgm3, virtual_temperature_k
 from pitotcal.core.units import isa_pressure_pa, isa_temperature_k
 from pitotcal.io import read_flight, write_flight_csv
 
@@ -50,8 +50,9 @@ def test_sensor_records_against_truth(tmp_path):
     from pitotcal.core.moist_air import with_static_air
     back = with_static_air(read_flight(path), temp_recovery=0.97)
     ts = isa_temperature_k(flight.alt_m)
-    # M from the measured q_ci (its pressure error and noise) instead of the true one
-    assert back.oat_k == pytest.approx(ts, abs=0.04)
+    # humid: oat_k is the virtual temperature; M from the measured q_ci (its pressure error
+    # and noise) instead of the true one
+    assert back.oat_k == pytest.approx(virtual_temperature_k(ts, flight.ps_pa, 70.0), abs=0.04)
     assert back.rho_kgm3 == pytest.approx(moist_density_kgm3(isa_pressure_pa(flight.alt_m),
                                                              ts, 70.0), rel=2e-4)
     assert json.loads(json.dumps(truth.options))["air_sensors"]["gps_bias_mps"] == [0, 0, 0]
@@ -68,7 +69,8 @@ def test_bad_sensor_options(bad, match):
 # --- each effect injected, and the budget term that should cover it -------------------------
 
 PLAN = {"duration_s": 120.0, "cas_kt": (70.0, 100.0), "radius_m": 600.0}
-SIM = {"seed": 11, "rate_hz": 10.0, "turbulence_mps": 0.3}
+# compressible truth, every flight logging ps_pa and oat_k: the default compressible fit
+SIM = {"seed": 11, "rate_hz": 10.0, "turbulence_mps": 0.3, "air_data": "compressible"}
 ZERO = bd.BudgetInputs(u_oat_k=0, u_rh_pct=0, u_gps_velocity_mps=0, u_gps_latency_s=0,
                        u_qc_scale=0, u_qc_offset_pa=0)
 # (source, simulate options injecting it, the budget input set to its size)
@@ -94,7 +96,7 @@ def clean():
 @pytest.mark.parametrize("source, inject, inputs", EFFECTS, ids=[e[0] for e in EFFECTS])
 def test_budget_term_covers_injected_bias(clean, source, inject, inputs):
     plan, base = clean
-    flight, _ = simulate(plan, **SIM, **inject)
+    flight, _ = simulate(plan, **SIM, **{"air_sensors": {}, **inject})
     if flight.rh_pct is not None:            # the logger does not know the humidity
         flight = dataclasses.replace(flight, rh_pct=None)
     result = identify(flight)

@@ -21,7 +21,7 @@ from pitotcal.maneuvers.profiles import make_schedule
 
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import Plan
-from pitotcal.core.units import G0_MPS2, cas_from_qc_mps, kt_to_mps, mps_to_kt
+from pitotcal.core.units import G0_MPS2, incompressible_cas_mps, kt_to_mps, mps_to_kt
 
 CENTER = (47.397742, 8.545594)
 
@@ -90,7 +90,7 @@ def test_staircase_with_return_leg_is_even_and_symmetric():
                 settings={"return_leg": True})
     cas, loiter_s, error = speed_levels(plan)
     assert len(cas) % 2 == 0 and cas == pytest.approx(cas[::-1]) and sum(loiter_s) == 240
-    assert error <= 2.5 and cas[0] > cas_from_qc_mps(s.qc_pa[0])
+    assert error <= 2.5 and cas[0] > incompressible_cas_mps(s.qc_pa[0])
 
 
 def test_downwind_bank_refused_with_the_radius_that_works(two_speed):

@@ -37,20 +37,20 @@ def fits(fast_plan):
     for mode in ad.AIR_DATA_MODES:
         flight, truth = simulate(fast_plan, seed=3, turbulence_mps=0.0, rate_hz=10.0,
                                  air_data=mode, keep_history=True)
-        out[mode] = flight, truth, identify(flight, model="inverse")
+        out[mode] = flight, truth, identify(flight, model="inverse", air="incompressible")
     return out
 
 
 def _true_corrections_kt(truth, vi_kt):
     """(ΔV_pc by the standard CAS law, ΔV by sqrt(2q/ρ0), and what an incompressible fit
     would report: V_e − V_i) at indicated `vi_kt`, from the true pressure-error model."""
-    qci = units.qc_from_cas_pa(units.kt_to_mps(vi_kt))
+    qci = units.incompressible_qc_pa(units.kt_to_mps(vi_kt))
     qc = qci / (1.0 - get_model(truth.model)(truth.k, qci))
     ps, oat = units.isa_pressure_pa(ALT_M), units.isa_temperature_k(ALT_M)
     tas = ad.mach_from_qc(qc, ps) * ad.speed_of_sound_mps(oat)
     eas_kt = units.mps_to_kt(tas * np.sqrt(units.isa_density_kgm3(ALT_M) / units.RHO0_KGM3))
     standard = units.mps_to_kt(ad.cas_from_qc_mps(qc) - ad.cas_from_qc_mps(qci))
-    plain = units.mps_to_kt(units.cas_from_qc_mps(qc)) - vi_kt
+    plain = units.mps_to_kt(units.incompressible_cas_mps(qc)) - vi_kt
     return standard, plain, eas_kt - vi_kt
 
 

@@ -17,7 +17,7 @@ import warnings
 
 from pitotcal import __version__
 
-COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study")
+COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study", "legs", "report")
 
 
 def build_parser():

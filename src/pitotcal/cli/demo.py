@@ -1,4 +1,5 @@
-"""`pitotcal demo`: plan, fly (simulate), identify and report the T-2 case (docs/interfaces.md)."""
+"""`pitotcal demo`: plan, fly (simulate), identify and report the T-2 case (docs/interfaces.md);
+the files it writes end with the calibration report, report.html."""
 
 from pitotcal.core.scenario import T2_PLAN
 
@@ -15,7 +16,8 @@ def add_parser(subparsers):
         "demo", help="the whole job on the paper's T-2 case, with known truth",
         description=f"Plan the T-2 maneuver ({_case()}, {t2['wind_speed_mps']:g} m/s wind), "
                     "fly it in the simulator (light turbulence, realistic sensors), identify the "
-                    "calibration and the wind, and print the calibration table next to the truth.")
+                    "calibration and the wind, print the calibration table next to the truth, and "
+                    "write the calibration report (report.html).")
     p.add_argument("--out", dest="out_dir", default="pitotcal-demo", metavar="DIR",
                    help="folder for plan, flight, result and figures (default: ./pitotcal-demo)")
     p.add_argument("--seed", type=int, default=0, help="simulator seed (default 0)")

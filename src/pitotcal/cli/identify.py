@@ -3,11 +3,14 @@
 Exit status: 0 success (also when the solver did not converge: the summary, the JSON's
 `converged: false` and a stderr warning say so); 2 unusable input, one stderr line naming
 file, column and row; 3 the data cannot separate the wind from the calibration.
+With `--params OUT`: 2 also when no parameter is recommended (one stderr line saying why,
+after the summary; the JSON and figure are written first).
 """
 
 from pathlib import Path
 
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
+AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_DATA_MODES
 
 
 def add_parser(subparsers):
@@ -23,6 +26,16 @@ def add_parser(subparsers):
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
+    # --- air data (issue 9) ---
+    p.add_argument("--air", default="compressible", metavar="MODE",
+                   help="how impact pressure follows from true airspeed: compressible "
+                        "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
+                        "all pressure error taken in the static source, or separated with "
+                        "a ps_ref_pa reference column; V_i, V_c standard CAS) or "
+                        "incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
+                        "paper's eq. 2 and the results before issue 9); a flight without "
+                        "ps_pa/oat_k is fitted incompressible with a warning; default "
+                        "%(default)s")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
@@ -37,6 +50,14 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
+    # issue 10: the airspeed parameter an autopilot loads (logic in estimation/autopilot.py)
+    g = p.add_argument_group("autopilot parameters")
+    g.add_argument("--params", metavar="OUT", default=None,
+                   help="write the recommended airspeed parameter: for an ArduPilot log a "
+                        "Mission Planner / MAVProxy parameter file with ARSPD_RATIO, for a PX4 "
+                        "log a QGroundControl parameter file with ASPD_SCALE_1 (the current "
+                        "value and the 2-sigma as comments); exit 2 with the reason when the "
+                        "flight cannot support one")
     _add_budget_arguments(p)
     p.set_defaults(run=run)
 
@@ -104,11 +125,12 @@ def run(args):
     from pitotcal.io import is_log_file, read_flight
 
     choice("model", args.model, [*MODELS, "auto"])
+    choice("air", args.air, AIR_CHOICES)
     if args.gps_noise_mps is not None:
         number("gps_noise_mps", args.gps_noise_mps, 0.0, 10.0, hi_open=True)
     source = Path(args.flight)
     # an output on top of the input, or one that cannot be written, is said before the work
-    for option, out in (("--json", args.json), ("--plot", args.plot)):
+    for option, out in (("--json", args.json), ("--plot", args.plot), ("--params", args.params)):
         if out is not None:
             check_output(option, out, source, "flight file")
     if args.plot is not None:
@@ -119,11 +141,21 @@ def run(args):
         number("rh_percent", args.rh_percent, 0.0, 100.0)
     inputs = None if args.no_budget else _budget_inputs(args)
 
-    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
-                         oat_k=oat_k_from_c(args.oat_c))
+    if args.params is None:
+        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                             oat_k=oat_k_from_c(args.oat_c))
+    else:
+        from pitotcal.io.param_files import read_flight_and_parameters
+        flight, autopilot, current = read_flight_and_parameters(
+            source, args.start_s, args.end_s, oat_k=oat_k_from_c(args.oat_c))
+        if autopilot is None:
+            from pitotcal.core.errors import PitotcalError
+            raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
+                                "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
     flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
-    result = identify(flight, model=args.model, gps_noise_std_mps=args.gps_noise_mps)
-    budget = None if inputs is None else uncertainty_budget(flight, result, inputs)
+    result = identify(flight, model=args.model, air=args.air,
+                      gps_noise_std_mps=args.gps_noise_mps)
+    budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
@@ -147,7 +179,25 @@ def run(args):
             plot_budget_band(fig.axes[0], result, budget)      # the ΔV axes
             fig.savefig(plot_path, dpi=110)
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
+    if args.params is not None:
+        _write_params(args, flight, autopilot, current)
     return 0
+
+
+def _write_params(args, flight, autopilot, current):
+    """The recommended airspeed parameter, or a PitotcalError (exit 2) saying why not."""
+    from pitotcal.estimation.autopilot import PARAMETER, recommend, write_parameter_file
+
+    name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
+        if autopilot == "PX4" else None
+    rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
+                    gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air)
+    write_parameter_file(rec, args.params)
+    print(f"\nRecommended {rec.name} = {rec.value:.4f} ± {rec.two_sigma:.4f} (2σ)"
+          + ("" if rec.current is None else f", now {rec.current:.6g}")
+          + f"; wrote {args.params}")
+    for note in rec.notes:
+        print(f"  note: {note}")
 
 
 def _write_json(path, result, flight, source, budget=None):

@@ -51,7 +51,10 @@ __all__ = [
     "qc_from_cas_pa",
     "qc_from_mach_pa",
     "qc_from_tas_pa",
+    "qc_from_tas_sq_derivatives",
     "qc_from_tas_sq_pa",
+    "qc_from_total_derivatives",
+    "qc_from_total_pa",
     "speed_of_sound_mps",
     "static_pressure_pa",
 ]
@@ -133,6 +136,57 @@ def qc_from_tas_sq_pa(tas_sq, ps_pa, oat_k, lib=np):
     return ps_pa * ((1.0 + 0.2 * mach_sq) ** 3.5 - 1.0)
 
 
+def qc_from_tas_sq_derivatives(tas_sq, ps_pa, oat_k, lib=np):
+    """(dq_c/dV_t², d²q_c/d(V_t²)²) of `qc_from_tas_sq_pa` at fixed p_s and T_s.
+
+    Notes
+    -----
+    With c = 0.2 / (γ R T_s): dq_c/dV_t² = 3.5 c p_s (1 + c V_t²)^2.5 (→ ½ρ as M → 0) and
+    d²q_c/d(V_t²)² = 2.5 c (dq_c/dV_t²) / (1 + c V_t²).
+    """
+    tas_sq, ps_pa, oat_k = _floats(lib, tas_sq, ps_pa, oat_k)
+    c = 0.2 / (GAMMA * R_AIR_JKGK * oat_k)
+    base = 1.0 + c * tas_sq
+    slope = 3.5 * c * ps_pa * base ** 2.5
+    return slope, 2.5 * c * slope / base
+
+
+def qc_from_total_pa(tas_sq, pt_pa, oat_k, lib=np):
+    """Impact pressure, Pa, of V_t² (m²/s²) at a known total pressure p_T (Pa) and T_s (K).
+
+    Notes
+    -----
+    p_T / p_s = (1 + 0.2 M²)^3.5 with p_T = p_s + q_c, so
+
+        q_c = p_T [1 − (1 + 0.2 M²)^−3.5],   M² = V_t² / (γ R T_s).
+
+    The calibration's prediction (`estimation.residual`): the static port reads
+    p_s,ind = p_s + Δp_p and the transducer q_ci = q_c − Δp_p, so their sum p_s,ind + q_ci is
+    the true total pressure whatever the static-source error, and q_c follows from V_t
+    without knowing Δp_p. As M → 0 this tends to ½ρV_t² with ρ = p_T / (R T_s).
+    """
+    tas_sq, pt_pa, oat_k = _floats(lib, tas_sq, pt_pa, oat_k)
+    mach_sq = tas_sq / (GAMMA * R_AIR_JKGK * oat_k)
+    if _numeric(lib):
+        _refuse_outside("mach", np.sqrt(np.abs(mach_sq)), 0.0, 1.0, "the subsonic range")
+    return pt_pa * (1.0 - (1.0 + 0.2 * mach_sq) ** -3.5)
+
+
+def qc_from_total_derivatives(tas_sq, pt_pa, oat_k, lib=np):
+    """(dq_c/dV_t², d²q_c/d(V_t²)²) of `qc_from_total_pa` at fixed p_T and T_s.
+
+    Notes
+    -----
+    With c = 0.2 / (γ R T_s): dq_c/dV_t² = 3.5 c p_T (1 + c V_t²)^−4.5 (→ ½ρ as M → 0) and
+    d²q_c/d(V_t²)² = −4.5 c (dq_c/dV_t²) / (1 + c V_t²).
+    """
+    tas_sq, pt_pa, oat_k = _floats(lib, tas_sq, pt_pa, oat_k)
+    c = 0.2 / (GAMMA * R_AIR_JKGK * oat_k)
+    base = 1.0 + c * tas_sq
+    slope = 3.5 * c * pt_pa * base ** -4.5
+    return slope, -4.5 * c * slope / base
+
+
 def qc_from_tas_pa(tas_mps, ps_pa, oat_k, lib=np):
     """Impact pressure, Pa, of a true airspeed (m/s) at static pressure (Pa) and temperature (K).
 
@@ -166,7 +220,7 @@ def cas_from_qc_mps(qc_pa, lib=np):
     -----
     V_c = a₀ sqrt(5 [(q_c/p₀ + 1)^(2/7) − 1]), a₀ = 340.294 m/s, p₀ = 101,325 Pa: the airspeed
     whose isentropic impact pressure at sea-level standard conditions is q_c. Differs from
-    `pitotcal.core.units.cas_from_qc_mps` (sqrt(2 q_c/ρ₀), the incompressible convention) by
+    `pitotcal.core.units.incompressible_cas_mps` (sqrt(2 q_c/ρ₀), the incompressible convention) by
     about −V_c (V_c/a₀)²/8. A negative q_c gives the negative of the speed of |q_c|.
 
     Example

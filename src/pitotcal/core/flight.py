@@ -25,6 +25,15 @@ class Flight:
         GPS velocity down, m/s; when present it enters the true-airspeed magnitude.
     alt_m : ndarray or None
         Altitude, m (for plots and checks only; NaN where the file had no usable value).
+    ps_pa : ndarray or None
+        Static pressure as the aircraft's static source reads it, Pa (p_s + Δp_p when the
+        static port has a position error). With `oat_k` it makes the compressible
+        calibration possible (`pitotcal.estimation.identify`, air="compressible").
+    oat_k : ndarray or None
+        Static (outside) air temperature, K.
+    ps_ref_pa : ndarray or None
+        An independent reference static pressure, Pa (trailing cone, tower fly-by, ground
+        barometer plus GPS height), when the flight has one.
     source : str
         Where the data came from (file name), used in error messages.
     meta : dict
@@ -34,9 +43,9 @@ class Flight:
     warnings : tuple of str
         Every warning the reader gave about this data (also issued with `warnings.warn`), so
         the result record can carry them.
-    ps_pa, oat_k, tat_k, rh_pct : ndarray or None
-        Static pressure (Pa), static and total air temperature (K), relative humidity (%), when
-        the data has them (issue 9; `pitotcal.core.moist_air.with_static_air` converts).
+    tat_k, rh_pct : ndarray or None
+        Total air temperature (K) and relative humidity (%), when the data has them
+        (`pitotcal.core.moist_air.with_static_air` turns them into `oat_k` and `rho_kgm3`).
     """
 
     time_s: np.ndarray
@@ -46,13 +55,14 @@ class Flight:
     rho_kgm3: np.ndarray
     gps_vd_mps: np.ndarray | None = None
     alt_m: np.ndarray | None = None
+    ps_pa: np.ndarray | None = None
+    oat_k: np.ndarray | None = None
+    ps_ref_pa: np.ndarray | None = None
     source: str = "<memory>"
     meta: dict = field(default_factory=dict)
     n_dropped: int = 0
     warnings: tuple = ()
-    # issue 9 (air data): optional channels
-    ps_pa: np.ndarray | None = None
-    oat_k: np.ndarray | None = None
+    # issue 9 (temperature and humidity): optional channels
     tat_k: np.ndarray | None = None
     rh_pct: np.ndarray | None = None
 
@@ -73,5 +83,5 @@ class Flight:
         return self.select((self.time_s >= lo) & (self.time_s <= hi))
 
 
-_ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m",
-           "ps_pa", "oat_k", "tat_k", "rh_pct")
+_ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m", "ps_pa",
+           "oat_k", "ps_ref_pa", "tat_k", "rh_pct")

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pitotcal.core.units import cas_from_qc_mps, kt_to_mps, mps_to_kt, qc_from_cas_pa
+from pitotcal.core import airdata
+from pitotcal.core.units import incompressible_cas_mps, incompressible_qc_pa, kt_to_mps, mps_to_kt
 
 __all__ = [
     "MODELS",
@@ -94,9 +95,18 @@ def qci_from_qc_pa(model, k, qc_pa, iterations=50):
     return qci
 
 
-def delta_v_kt(model, k, vi_kt):
-    """Airspeed correction ΔV = V_c - V_i, kt, at indicated airspeed `vi_kt` (docs/interfaces.md §2):
-    q_ci = rho0 V_i^2 / 2, q_c = q_ci / (1 - f(q_ci)), V_c = sqrt(2 q_c / rho0)."""
+def delta_v_kt(model, k, vi_kt, air_data="incompressible"):
+    """Airspeed correction ΔV = V_c - V_i, kt, at indicated airspeed `vi_kt`.
+
+    q_ci is the impact pressure of V_i, q_c = q_ci / (1 - f(q_ci)), V_c the airspeed of q_c,
+    both through the same law: sqrt(2 q / rho0) with `air_data` "incompressible"
+    (docs/interfaces.md §2), or the standard calibrated-airspeed law
+    (`pitotcal.core.airdata.cas_from_qc_mps`) with "compressible", where V_i is the
+    instrument-corrected indicated airspeed V_ic and ΔV the position-error correction ΔV_pc.
+    """
     vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
-    qc = qc_from_qci_pa(model, k, qc_from_cas_pa(vi_mps))
-    return mps_to_kt(cas_from_qc_mps(qc) - vi_mps)
+    if air_data == "compressible":
+        qc = qc_from_qci_pa(model, k, airdata.qc_from_cas_pa(vi_mps))
+        return mps_to_kt(airdata.cas_from_qc_mps(qc) - vi_mps)
+    qc = qc_from_qci_pa(model, k, incompressible_qc_pa(vi_mps))
+    return mps_to_kt(incompressible_cas_mps(qc) - vi_mps)

@@ -16,7 +16,8 @@ same pressure and temperature: humid air is 0.3-1.6 % less dense than dry at 15-
 RH. γ is taken as 1.4 for moist air too (the change is below 0.1 %).
 
 `with_static_air` turns a `Flight` with these columns into the Flight the estimator needs:
-static `oat_k`, and `rho_kgm3` through the virtual temperature.
+`oat_k` the static temperature (virtual when humid: the compressible relations take it for
+both the density and the speed of sound) and `rho_kgm3` = p_s / (R T_v).
 """
 
 import dataclasses
@@ -41,6 +42,7 @@ __all__ = [
 EPSILON = 0.622                       # R_d / R_v, molar mass of water over that of dry air
 _C_TO_K = 273.15
 _OAT_SOURCE = "oat_k_source"          # Flight.meta key: how oat_k was obtained
+_OAT_VIRTUAL = "oat_k_is"             # Flight.meta key: present when oat_k is virtual
 # Alduchov & Eskridge (1996) eq. 21, over water
 _AE_A_PA, _AE_B, _AE_C_C = 610.94, 17.625, 243.04
 
@@ -113,9 +115,12 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     -------
     Flight
         `flight` itself when it has neither `tat_k` nor humidity; else a copy with `oat_k`
-        (static) and `rho_kgm3` = p_s / (R T_v), and the humidity used in `rh_pct`; an
-        `oat_k` converted from `tat_k` is marked in `meta["oat_k_source"]`, so a second call
-        (the reader calls it with r = 1, `identify --temp-recovery` again) converts again.
+        the static temperature — the virtual temperature T_v when a humidity is known
+        (`meta["oat_k_is"]` says so), as the compressible relations and the density both
+        need it — `rho_kgm3` = p_s / (R T_v), and the humidity used in `rh_pct`. An `oat_k`
+        converted from `tat_k` is marked in `meta["oat_k_source"]`; a second call (the
+        reader calls it with r = 1 and the file's humidity, `identify --temp-recovery` and
+        `--rh-percent` again) converts from the raw inputs again.
 
     Raises
     ------
@@ -132,6 +137,8 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     tat, oat = flight.tat_k, flight.oat_k
     if tat is not None and flight.meta.get(_OAT_SOURCE, "").startswith("tat_k"):
         oat = None                    # converted before (by the reader): again, with this r
+    elif oat is not None and _OAT_VIRTUAL in flight.meta and flight.rh_pct is not None:
+        oat = _dry_from_virtual_k(oat, flight.ps_pa, flight.rh_pct)    # humidity applied before
     rh = flight.rh_pct if rh_pct is None else np.full(flight.n, rh_pct)
     if tat is None and rh is None:
         return flight
@@ -145,7 +152,7 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
         message += "; ignored, the density is the file's rho_kgm3"
         warnings.warn(message, stacklevel=2)
         return dataclasses.replace(flight, warnings=(*flight.warnings, message))
-    meta = dict(flight.meta)
+    meta = {k: v for k, v in flight.meta.items() if k != _OAT_VIRTUAL}
     if oat is None:
         oat = static_temperature_k(tat, flight.qci_pa, ps, temp_recovery)
         meta[_OAT_SOURCE] = f"tat_k, recovery factor {temp_recovery:g}"
@@ -153,7 +160,21 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
         bad = int(np.argmax((rh < 0) | (rh > 100)))
         raise FlightDataError(f"{flight.source}: column rh_pct, row {bad + 1}: {rh[bad]:g} is "
                               "outside 0-100 %")
-    rho = moist_density_kgm3(ps, oat, 0.0 if rh is None else rh)
-    return dataclasses.replace(flight, oat_k=np.asarray(oat, dtype=float), rho_kgm3=rho,
+    t_air = np.asarray(oat, dtype=float)
+    if rh is not None:
+        # the air-data relations take the virtual temperature: the dry-air temperature of
+        # the same density (ρ = p/(R T_v)) and, within 0.1 %, speed of sound (a² = γ R T_v)
+        t_air = virtual_temperature_k(t_air, ps, rh)
+        meta[_OAT_VIRTUAL] = "virtual temperature (rh_pct applied)"
+    return dataclasses.replace(flight, oat_k=t_air, rho_kgm3=ps / (R_AIR_JKGK * t_air),
                                rh_pct=rh, meta=meta)
+
+
+def _dry_from_virtual_k(tv_k, ps_pa, rh_pct):
+    """T from T_v = T / (1 − (e(T)/p)(1 − ε)): a fixed point contracting by ≤ 0.3 a step."""
+    t = np.asarray(tv_k, dtype=float)
+    for _ in range(30):
+        e_pa = np.asarray(rh_pct, float) / 100.0 * saturation_vapour_pressure_pa(t)
+        t = tv_k * (1.0 - e_pa / ps_pa * (1.0 - EPSILON))
+    return t
 

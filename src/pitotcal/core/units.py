@@ -16,16 +16,16 @@ __all__ = [
     "NM_TO_M",
     "RHO0_KGM3",
     "R_AIR_JKGK",
-    "cas_from_qc_mps",
     "density_kgm3",
     "ft_to_m",
+    "incompressible_cas_mps",
+    "incompressible_qc_pa",
     "isa_density_kgm3",
     "isa_pressure_pa",
     "isa_temperature_k",
     "kt_to_mps",
     "m_to_ft",
     "mps_to_kt",
-    "qc_from_cas_pa",
     "wind_polar",
     "wind_vector_mps",
 ]
@@ -72,8 +72,12 @@ def wind_polar(wind_n_mps, wind_e_mps):
     return speed, np.where(from_deg >= 360.0, 0.0, from_deg)[()]   # -1e-16 % 360 -> 360.0
 
 
-def cas_from_qc_mps(qc_pa):
-    """Calibrated airspeed from impact pressure, V = sqrt(2 q / rho0) (docs/interfaces.md §2).
+def incompressible_cas_mps(qc_pa):
+    """The incompressible airspeed of an impact pressure, V = sqrt(2 q / rho0), m/s.
+
+    The convention of docs/interfaces.md §2 and of `--air incompressible` (the paper's eq. 2):
+    the standard calibrated airspeed is `pitotcal.core.airdata.cas_from_qc_mps`, which is
+    lower by about V (V/a0)^2 / 8.
 
     Negative pressures give a negative speed of the same magnitude rather than NaN, so a
     correction curve stays continuous near zero.
@@ -82,8 +86,9 @@ def cas_from_qc_mps(qc_pa):
     return np.sign(qc) * np.sqrt(2.0 * np.abs(qc) / RHO0_KGM3)
 
 
-def qc_from_cas_pa(cas_mps):
-    """Impact pressure of a calibrated airspeed, q = rho0 V^2 / 2."""
+def incompressible_qc_pa(cas_mps):
+    """Impact pressure of an incompressible airspeed, q = rho0 V^2 / 2 (inverse of
+    `incompressible_cas_mps`)."""
     return 0.5 * RHO0_KGM3 * np.asarray(cas_mps, dtype=float) ** 2
 
 

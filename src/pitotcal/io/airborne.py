@@ -20,7 +20,7 @@ Two cuts, both computed over the whole log (so a window cannot make them differ)
 
 import numpy as np
 
-from pitotcal.core.units import cas_from_qc_mps
+from pitotcal.core.units import incompressible_cas_mps
 
 from .resample import hold
 from .timebase import clean
@@ -55,7 +55,7 @@ def flight_state_cuts(s, t, qci_pa, min_airspeed_mps=None):
         cuts[f"autopilot not flying ({s.airborne_source})"] = ~airborne
     gate, source = airspeed_gate(s, min_airspeed_mps)
     if gate:
-        fast = cas_from_qc_mps(qci_pa) >= gate
+        fast = incompressible_cas_mps(qci_pa) >= gate
         cuts[f"take-off or landing: IAS < {gate:g} m/s ({source})"] = gate_ends(airborne, fast)
     return cuts
 

@@ -31,7 +31,7 @@ import numpy as np
 
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.flight import Flight
-from pitotcal.core.units import RHO0_KGM3, density_kgm3, isa_temperature_k
+from pitotcal.core.units import R_AIR_JKGK, RHO0_KGM3, density_kgm3, isa_temperature_k
 
 from .resample import hold
 
@@ -180,8 +180,11 @@ def read_alfa_flight(data_dir, *, oat="autopilot", powered_only=True, margin_s=1
     ok &= _powered(d, t_unix, t0, powered_only, margin_s, meta)
     if np.count_nonzero(ok) < 10:
         raise FlightDataError(f"{d / 'scaled_pressure.csv'}: fewer than 10 usable samples")
+    # the static pressure and the temperature the density implies, for the compressible fit
+    oat_k = ps / (R_AIR_JKGK * rho)
     return Flight(time_s=t_unix[ok] - t0, qci_pa=qci[ok], gps_vn_mps=vn[ok], gps_ve_mps=ve[ok],
                   rho_kgm3=rho[ok], gps_vd_mps=None if vd is None else vd[ok],
+                  ps_pa=ps[ok], oat_k=oat_k[ok],
                   alt_m=None, source=str(d), meta=meta, n_dropped=int(np.count_nonzero(~ok)),
                   warnings=tuple(notes))
 

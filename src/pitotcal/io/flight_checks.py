@@ -21,7 +21,7 @@ QCI_MIN_FLYING_PA = 20.0     # 0.5 * 1.225 * (11 kt)^2: nothing that flies is sl
 # Read when present but never used in the fit (plots, checks): a bad cell there is NaN in
 # `Flight.alt_m`, not a reason to drop the row or reject the file.
 INFORMATIVE = ("alt_m",)
-_POSITIVE = ("qc_pa", "rho_kgm3", "ps_pa", "oat_k")
+_POSITIVE = ("qc_pa", "rho_kgm3", "ps_pa", "oat_k", "ps_ref_pa")
 
 # Unit diagnosis (see the flight_csv module docstring). q_ci / (0.5 rho |V_g|^2) of a flying
 # aircraft is 1 / (1 + (W/V)^2) on a full circle and at worst (1 -/+ W/V)^-2 on one leg:
@@ -151,14 +151,15 @@ def check_rho(name, rho):
                           f"kg/m^3 (0.15-1.6){unit}")
 
 
-def check_ps_oat(name, ps, oat):
+def check_ps_oat(name, ps, oat, column="ps_pa"):
+    """Static pressure in Pa (not hPa, kPa, psi, inHg) and temperature in K (not degC)."""
     med = float(np.median(ps))
     if not 5e3 <= med <= 1.2e5:
         unit = next((u for u, lo, hi in (("hPa (mbar)", 150, 1200), ("kPa", 5, 120),
                                          ("psi", 0.7, 17), ("inHg", 1.5, 35.4)) if lo <= med <= hi),
                     None)
         looks = f"looks like {unit}" if unit else "is not a static pressure"
-        raise FlightDataError(f"{name}: column ps_pa: median {med:.5g} {looks}; expected Pa "
+        raise FlightDataError(f"{name}: column {column}: median {med:.5g} {looks}; expected Pa "
                               "(about 101325 at sea level)")
     med = float(np.median(oat))
     if med < 150:

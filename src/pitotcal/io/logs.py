@@ -216,7 +216,7 @@ def _assemble(s, name, start_s, end_s, opt):
     t, q, n_bad_rows, state = _pressure_in_window(s, name, start_s, end_s, opt.min_airspeed)
     gps = gps_onto(t, s, name, opt.gps_resample, opt.gps_latency_s)
     cuts = {**state, "no valid GPS fix": ~gps.ok}
-    rho, static_ok, temp_source = _density(s, t, gps.alt, opt.oat_k)
+    rho, static_ok, temp_source, ps, oat = _density(s, t, gps.alt, opt.oat_k)
     if static_ok is not None:
         cuts["no static pressure"] = ~static_ok
     slow = {**state,
@@ -239,7 +239,7 @@ def _assemble(s, name, start_s, end_s, opt):
         else f"{reason}: {n}" for reason, n in excluded.items()) or "none"
     meta = _meta(s, name, kt, (start_s, end_s), temp_source, opt, excluded_text, wind)
     flight = Flight(time_s=kt, qci_pa=q[keep], gps_vn_mps=gps.vn[keep], gps_ve_mps=gps.ve[keep],
-                    rho_kgm3=rho[keep],
+                    rho_kgm3=rho[keep], ps_pa=ps[keep], oat_k=oat[keep],
                     gps_vd_mps=gps.vd[keep] if s.gps_vd is not None else None,
                     alt_m=gps.alt[keep] if s.gps_alt_m is not None else None,
                     source=name, meta=meta, n_dropped=int(t.size - keep.sum() + n_bad_rows),
@@ -274,7 +274,10 @@ def _inside(t, start_s, end_s):
 
 
 def _density(s, t, alt, oat_k):
-    """(rho, static_ok or None, temperature source): ps / (R T) on the times `t`.
+    """(rho, static_ok or None, temperature source, ps, T): ps / (R T) on the times `t`.
+
+    ps (the static source's pressure) and T also go into the Flight for the compressible
+    calibration, with the same substitutions as the density.
 
     Records every substitution in `s.conversions` (warned later).
     """
@@ -301,7 +304,7 @@ def _density(s, t, alt, oat_k):
         temp = isa_temperature_k(alt)
         temp_source = "ISA at GPS altitude (no temperature in the log)"
         s.conversions.append("no temperature in the log: ISA temperature at the GPS altitude")
-    return density_kgm3(ps, temp), static_ok, temp_source
+    return density_kgm3(ps, temp), static_ok, temp_source, ps, temp
 
 
 def _warn_all(name, s):

@@ -1,0 +1,72 @@
+"""`pitotcal report`: the calibration report, one self-contained HTML file (issue 10).
+
+Exit status: 0 written; 2 unusable input (result JSON, flight, aircraft TOML, options), one
+stderr line naming the file or flag.
+"""
+
+from pathlib import Path
+
+REGULATION_CHOICES = ("23.1323", "25.1323", "none")
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "report", help="write the calibration report (HTML, optionally PDF) from a result JSON",
+        description="Render a self-contained HTML calibration report from the JSON of "
+                    "`pitotcal identify --json`: title block, test conditions, method, the "
+                    "KIAS->KCAS and altimeter correction tables with 2-sigma and U, figures, "
+                    "warnings, a compliance verdict per speed, provenance and signatures.")
+    p.add_argument("result", metavar="RESULT.json", help="result JSON of `pitotcal identify`")
+    p.add_argument("-o", "--output", required=True, metavar="REPORT.html",
+                   help="the HTML report to write")
+    p.add_argument("--flight", metavar="FLIGHT", default=None,
+                   help="the flight the result came from (CSV or log, read with its defaults): "
+                        "adds test conditions, the calibration figure with residuals and the "
+                        "ground track (the fit is re-run on it and checked against the result)")
+    p.add_argument("--start-s", type=float, default=None, metavar="S",
+                   help="with --flight: the window identify used (time_s >= S)")
+    p.add_argument("--end-s", type=float, default=None, metavar="S",
+                   help="with --flight: the window identify used (time_s <= S)")
+    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
+                   help="with --flight, logs only: the outside air temperature identify used")
+    p.add_argument("--aircraft", metavar="AIRCRAFT.toml", default=None,
+                   help="title block: [aircraft] type, registration, configuration, weight, cg; "
+                        "[test] date, location, pilot, engineer, notes")
+    p.add_argument("--regulation", default="23.1323", metavar="R",
+                   help="23.1323, 25.1323 or none (default %(default)s)")
+    p.add_argument("--speed-range-kt", nargs=2, type=float, default=None, metavar=("LO", "HI"),
+                   help="calibrated-airspeed range for the verdict, KCAS (default: the flown "
+                        "range, and the report says so; speeds not flown are not demonstrated)")
+    p.add_argument("--json", metavar="OUT.json", default=None,
+                   help="also write the result with the report's \"compliance\" block added")
+    p.add_argument("--pdf", metavar="REPORT.pdf", default=None,
+                   help="also print the report to PDF with headless Chromium")
+    p.set_defaults(run=run)
+
+
+def run(args):
+    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.core.checks import choice
+    from pitotcal.estimation.calibration_report import make_report
+
+    choice("regulation", args.regulation, REGULATION_CHOICES)
+    source = Path(args.result)
+    for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
+        if out is not None:
+            check_output(option, out, source, "result JSON")
+    options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
+    read = {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c)}
+    done = make_report(source, args.output, flight_path=args.flight, flight_options=read,
+                       aircraft_path=args.aircraft, regulation=args.regulation,
+                       speed_range_kt=args.speed_range_kt, json_path=args.json,
+                       pdf_path=args.pdf, options=options)
+    verdict = done["compliance"].get("verdict")
+    if verdict:
+        print(f"Compliance ({args.regulation}): {verdict}, "
+              f"{done['compliance']['speed_range_kt'][0]:.1f}-"
+              f"{done['compliance']['speed_range_kt'][1]:.1f} KCAS "
+              f"({done['compliance']['speed_range_source']} range; "
+              f"{done['compliance']['uncertainty']} uncertainty)")
+    for path in done["written"]:
+        print(f"Wrote {path}")
+    return 0

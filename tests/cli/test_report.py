@@ -1,0 +1,56 @@
+"""`pitotcal report`: from a real identify result with its flight; JSON and errors."""
+
+import json
+
+import pytest
+from reportfixtures import result_json
+from synthetic import synthetic_flight
+
+from pitotcal.cli import main
+from pitotcal.io import write_flight_csv
+
+
+@pytest.fixture(scope="module")
+def identified(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("report")
+    flight, _ = synthetic_flight(seed=5, n=3000, k=(0.02, -15.0))
+    csv = tmp / "flight.csv"
+    write_flight_csv(flight, csv)
+    result = tmp / "result.json"
+    assert main(["identify", str(csv), "--json", str(result)]) == 0
+    return csv, result
+
+
+def test_report_with_flight_has_three_figures_and_provenance(identified, tmp_path, capsys):
+    csv, result = identified
+    html, out_json = tmp_path / "r.html", tmp_path / "r.json"
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(html),
+                 "--json", str(out_json), "--speed-range-kt", "72", "95"]) == 0
+    out = capsys.readouterr().out
+    assert "Compliance (23.1323): complies, 72.0-95.0 KCAS (given range" in out
+    text = html.read_text()
+    assert text.count("data:image/png;base64,") == 3    # correction, calibration, track
+    assert "does not reproduce" not in text
+    assert str(csv) in text and "SHA-256" in text
+    block = json.loads(out_json.read_text())["compliance"]
+    assert block["speed_range_kt"] == [72.0, 95.0] and block["verdict"] == "complies"
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--regulation", "CS-VLA"], "--regulation 'CS-VLA' is not one of 23.1323, 25.1323, none"),
+    (["--speed-range-kt", "90", "80"], "--speed-range-kt 90 80: the highest speed must be"),
+    (["--aircraft", "missing.toml"], "missing.toml"),
+])
+def test_bad_options_exit_2_with_one_line(tmp_path, capsys, args, match):
+    res = tmp_path / "res.json"
+    res.write_text(json.dumps(result_json()))
+    assert main(["report", str(res), "-o", str(tmp_path / "r.html"), *args]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and match in err[0]
+
+
+def test_output_on_top_of_input_refused(tmp_path, capsys):
+    res = tmp_path / "res.json"
+    res.write_text(json.dumps(result_json()))
+    assert main(["report", str(res), "-o", str(res)]) == 2
+    assert "would overwrite the input result JSON" in capsys.readouterr().err

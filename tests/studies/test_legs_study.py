@@ -1,0 +1,37 @@
+"""The `legs` study: lean in CI (a few runs), full size (100 runs per case) marked slow."""
+
+import json
+import re
+
+import pytest
+from pitotcal.studies.catalog import STUDIES, rerun, run_study
+from pitotcal.studies.runner import read_table
+
+HEADLINE = (r"scatter: global ΔV ±\d\.\d\d kt vs per point ±\d+\.\d\d kt \(median 95 % "
+            r"half-widths\), coverage global \S+%, per point \S+%; stated: .+")
+
+
+def test_legs_study_lean(tmp_path):
+    summary = run_study("legs", runs=3, out_dir=tmp_path, workers=0, quick=True, seed=5)
+    rows = read_table(tmp_path / "legs.csv")
+    assert len(rows) == summary["n_rows"] == 3 * 2 * 7 and summary["n_failed"] == 0
+    assert {"run_index", "seed", "bound", "ias_kt", "dv_true_kt", "point_half_kt",
+            "global_half_kt", "point_inside", "global_inside"} <= set(rows[0])
+    on_disk = json.loads((tmp_path / "legs.json").read_text())
+    assert set(on_disk["by_bound"]) == {"scatter", "stated"}
+    assert re.fullmatch(HEADLINE, summary["headline"]), summary["headline"]
+    assert (tmp_path / "legs.png").stat().st_size > 20_000
+    # the same legs: the global band is the narrower in (nearly) every point
+    assert on_disk["by_bound"]["stated"]["global_narrower_share"] == 1.0
+    assert rerun("legs", 1, runs=3, seed=5, quick=True)[0]["seed"] == rows[7]["seed"]
+    assert STUDIES["legs"].description
+
+
+@pytest.mark.slow
+def test_legs_study_full_size(tmp_path):
+    """100 leg flights per case: coverage of both methods within 90-98 %, global narrower."""
+    summary = run_study("legs", out_dir=tmp_path, workers=1, seed=0)
+    for case in summary["by_bound"].values():
+        assert 0.90 <= case["coverage_point"] <= 0.98
+        assert 0.90 <= case["coverage_global"] <= 0.98
+        assert case["median_half_global_kt"] < case["median_half_point_kt"]
