@@ -2,7 +2,9 @@
 
 Planning: `profiles` (the q(t) schedules), `ocp` (the lateral-path optimal-control problem),
 `planner` (`plan_maneuver`), `outputs` (plan CSV companions: pilot card, setpoints, figure),
-`missions` (the plan as an autopilot mission: loiter circles and speed changes).
+`missions` (the plan as an autopilot mission: loiter circles and speed changes), `design`
+(information-optimal speed schedules, `plan_maneuver(design="optimal")`), `card` (pilot-card
+parts and picture).
 Flying: `simulator` (`simulate`), `autopilot` (guidance, auto-throttle, the stepping loop),
 `autothrottle` (the PI speed loop and its check), `turbulence`, `sensors`, `truth`.
 
@@ -27,6 +29,8 @@ _EXPORTS = {
     "export_mission": ".missions",
     "loiter_plan": ".missions",
     "plan_maneuver": ".planner",
+    "DesignOptions": ".design_request",
+    "predict_plan_band_kt": ".design",
     "simulate": ".simulator",
     "Tracking": ".truth",
     "Truth": ".truth",

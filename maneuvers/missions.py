@@ -15,6 +15,7 @@ Each refusal names the radius (or duration) that works.
 
 import math
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -105,10 +106,16 @@ def _stepped_levels(plan):
     """The plan's own levels; level i lasts from the end of dwell i-1 (the autopilot ramps
     during the loiter that follows a speed change) to the end of dwell i."""
     levels = plan.settings["levels_qc_pa"]
-    ends = []
-    for q in levels[:-1]:
-        at = np.flatnonzero(np.isclose(plan.qc_pa, q, rtol=1e-6, atol=1e-3))
-        ends.append(plan.time_s[at[-1]])
+    ends, start = [], 0
+    for q, following in pairwise(levels):
+        # in flying order (a designed plan may come back to a level): the end of this dwell
+        # is the last node at q before the first node at the next level
+        at = np.isclose(plan.qc_pa, q, rtol=1e-6, atol=1e-3)
+        nxt = start + np.flatnonzero(np.isclose(plan.qc_pa[start:], following, rtol=1e-6,
+                                                atol=1e-3))[0]
+        last = np.flatnonzero(at[:nxt])[-1]
+        ends.append(plan.time_s[last])
+        start = nxt
     bounds = [plan.time_s[0], *ends, plan.time_s[-1]]
     return tuple(float(incompressible_cas_mps(q)) for q in levels), _whole_seconds(bounds), None
 
@@ -212,6 +219,11 @@ def check_loiter(plan):
     the highest ground speed, downwind at the fastest airspeed.
     """
     s = plan.settings
+    if s.get("turn") == "both":
+        raise PlanInfeasibleError(
+            "turn both cannot be exported: the mission is one loiter circle at the centre, "
+            "flown one way (ArduPilot and PX4 take the direction per loiter item, not within "
+            "one); export a plan with turn right or left", param="turn")
     radius, wind = float(s["radius_m"]), float(s["wind_speed_mps"])
     bank_max = float(s["bank_max_deg"])
     vg_max = float(np.max(plan.tas_mps)) + wind
@@ -227,7 +239,8 @@ def check_loiter(plan):
     wind_ne = tuple(float(w) for w in wind_vector_mps(wind, s["wind_from_deg"]))
     turn = min(_heading_turns_rad(plan, radius, wind_ne))
     if turn < 2 * np.pi:
-        where = "dwell" if len(s.get("levels_qc_pa") or ()) == 2 else "third of the q range"
+        # two coverage groups: two-speed's dwells or a designed plan's end levels
+        where = "dwell" if len(s.get("coverage_runs") or ()) == 2 else "third of the q range"
         fits = _coverage_radius_m(plan, radius, wind_ne)
         head = (f"a {radius:g} m loiter circle turns only {math.degrees(turn):.0f}° of heading "
                 f"in one {where}")

@@ -23,9 +23,14 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.processes import solver_interrupts
 from pitotcal.core.units import G0_MPS2
 
-__all__ = ["Layout", "ManeuverProblem", "PathSolution", "path_rhs", "rk4_step", "turn_radius_m"]
+__all__ = ["TURNS", "Layout", "ManeuverProblem", "PathSolution", "group_signs", "node_signs",
+           "path_rhs", "rk4_step", "turn_radius_m"]
 
 TURN_SIGN = {"right": 1.0, "left": -1.0}
+# Turn directions the OCP takes: "both" alternates right and left orbits from one coverage
+# group to the next (in the order the groups are first flown), so a term that goes with the
+# turn rate (a probe's lever arm) averages out.
+TURNS = ("right", "left", "both")
 _KM = 1000.0          # position scale
 _PSI = 10.0           # heading scale (unwrapped heading reaches ~20 rad)
 _P = 0.1              # roll-rate scale, rad/s
@@ -36,6 +41,33 @@ _PATH_STATES = ("north_m", "east_m", "heading_rad", "bank_rad", "tas_mps")
 def turn_radius_m(tas_mps, bank_rad):
     """Radius of a steady coordinated turn in still air, V^2 / (g tan(bank))."""
     return np.asarray(tas_mps) ** 2 / (G0_MPS2 * np.tan(bank_rad))
+
+
+def group_signs(groups, turn):
+    """Turn sense (+1 right, -1 left) of each coverage group; "both": alternating in the order
+    the groups are first flown, starting right."""
+    if turn != "both":
+        return np.full(len(groups), TURN_SIGN[turn])
+    order = np.argsort([min(a for a, _ in runs) if runs else 0 for runs in groups])
+    signs = np.empty(len(groups))
+    signs[order] = np.where(np.arange(len(groups)) % 2 == 0, 1.0, -1.0)
+    return signs
+
+
+def node_signs(groups, signs, n_nodes):
+    """The turn sense at each node: its group's, a node in no group keeps the one before (the
+    first group's before any)."""
+    out = np.full(n_nodes, np.nan)
+    for g, runs in enumerate(groups):
+        for a, b in runs:
+            out[a:b + 1] = signs[g]
+    first = signs[int(np.argmin([min(a for a, _ in runs) if runs else n_nodes
+                                 for runs in groups]))]
+    out[0] = first if np.isnan(out[0]) else out[0]
+    for i in range(1, n_nodes):
+        if np.isnan(out[i]):
+            out[i] = out[i - 1]
+    return out
 
 
 class Layout:
@@ -215,7 +247,7 @@ class ManeuverProblem:
             Air-mass velocity north, east (the way it blows TO), m/s.
         bank_max_rad, roll_rate_max_rps : float
             Limits.
-        turn : {"right", "left"}
+        turn : {"right", "left", "both"}
         margin_m : float
             Radius margin: the constraint holds at the nodes, the track overshoots by < 0.1 m
             between them (docs/measured.md).
@@ -235,7 +267,7 @@ class ManeuverProblem:
             raise PitotcalError(f"schedule has {schedule.n_intervals} intervals and "
                                 f"{len(schedule.groups)} groups; this problem was built for "
                                 f"{n} and {self.n_groups}")
-        sign = TURN_SIGN[turn]
+        sign = group_signs(schedule.groups, turn)
         r_lim = (radius_m - margin_m) / _KM
         bounds = self._bounds(bank_max_rad, roll_rate_max_rps / _P, heading_margin_rad,
                               None if minimize_radius else r_lim ** 2)
@@ -265,8 +297,8 @@ class ManeuverProblem:
         cover = np.zeros((self.n_groups, m))
         for g, runs in enumerate(schedule.groups):
             for first, last in runs:
-                cover[g, last] += sign
-                cover[g, first] -= sign
+                cover[g, last] += sign[g]
+                cover[g, first] -= sign[g]
         par = np.empty(self.p.size)
         par[self.p["h_s"]] = np.diff(schedule.time_s)
         par[self.p["tas_mps"]] = schedule.tas_mps
@@ -308,10 +340,13 @@ class ManeuverProblem:
                    for runs in schedule.groups)
         tan_cover = 1.2 * (2 * np.pi + heading_margin_rad) / (G0_MPS2 * max(need, 1e-9))
         bank = min(np.arctan(max(tan_fit, tan_cover)), 0.95 * bank_max_rad)
-        psi = sign * G0_MPS2 * np.tan(bank) * turn_unit
+        # per node: the sign of the group flown (nodes between groups keep the last one)
+        node_sign = node_signs(schedule.groups, sign, t.size)
+        psi = G0_MPS2 * np.tan(bank) * np.r_[0.0, np.cumsum(np.diff(turn_unit)
+                                                            * node_sign[1:])]
         r = turn_radius_m(tas, bank)
         return self._pack(PathSolution(
-            north_m=sign * r * np.sin(psi), east_m=-sign * r * np.cos(psi), heading_rad=psi,
-            bank_rad=np.full(t.size, sign * bank), roll_rate_rps=np.zeros(t.size - 1),
+            north_m=node_sign * r * np.sin(psi), east_m=-node_sign * r * np.cos(psi),
+            heading_rad=psi, bank_rad=node_sign * bank, roll_rate_rps=np.zeros(t.size - 1),
             radius_m=radius_m, success=False, message="guess", iterations=0,
             solve_time_s=0.0))

@@ -15,6 +15,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+from pitotcal.maneuvers.card import calibration_lines, design_lines, kias_targets, turn_text
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.processes import side_by_side
@@ -22,6 +23,9 @@ from pitotcal.core.scenario import ALT_TOLERANCE_FT, CAS_TOLERANCE_KT
 from pitotcal.core.units import m_to_ft, mps_to_kt
 from pitotcal.io.plan_csv import write_plan
 from pitotcal.io.resample import hold
+
+# Bank cues are to be held within this, degrees: the track, not the exact bank, matters.
+BANK_TOLERANCE_DEG = 5.0
 
 __all__ = [
     "autothrottle_setpoints",
@@ -118,6 +122,7 @@ def pilot_card_text(plan, cue_s=15.0):
     s = plan.settings
     geo = "center_lat_deg" in s
     magnetic = geo and "magvar_deg" in s
+    kias = kias_targets(plan)
     alt_ft = float(m_to_ft(np.mean(plan.alt_m)))
     alt_ref = f" {str(s.get('altitude_ref', 'msl')).upper()}" if geo else ""
     wind_kt = float(mps_to_kt(s.get("wind_speed_mps", 0.0)))
@@ -131,15 +136,18 @@ def pilot_card_text(plan, cue_s=15.0):
         f"Altitude {alt_ft:.0f} ft{alt_ref} +-{ALT_TOLERANCE_FT:.0f} ft | airspeed target "
         f"+-{CAS_TOLERANCE_KT:.0f} KCAS | "
         f"stay within {m_to_ft(s.get('radius_m', np.nan)):.0f} ft of centre",
-        f"Turns {s.get('turn', 'right')}, bank max {s.get('bank_max_deg', '?')}° | "
+        f"{turn_text(s)}, bank max {s.get('bank_max_deg', '?')}° | "
         f"expected wind {wind}",
         f"Start {m_to_ft(np.hypot(plan.north_m[0], plan.east_m[0])):.0f} ft from centre on "
         f"bearing {_bearing_deg(plan, 0):03.0f}°, heading {_heading_cue(plan, 0):03.0f}°, "
         f"{_bank_cue(plan.bank_deg[0])}, {mps_to_kt(plan.cas_mps[0]):.0f} KCAS",
         *(_geo_lines(plan) if geo else []),
-        "HDG: heading flown, °true | FROM CTR: distance and bearing from the centre",
+        *design_lines(s),
+        ("HDG: heading flown, °true | FROM CTR: distance and bearing from the centre | "
+         f"BANK: within {BANK_TOLERANCE_DEG:.0f}° of the cue"),
+        *calibration_lines(s),
         "",
-        (f"{'TIME':>5}  {'KCAS':>9}  {'BANK':>5}  {'HDG':>4}  "
+        (f"{'TIME':>5}  {'KCAS':>9}  {'KIAS  ' if kias is not None else ''}{'BANK':>5}  {'HDG':>4}  "
          f"{'MAG  ' if magnetic else ''}{'FROM CTR':>14}  SPEED CUE"),
     ]
     accel = np.diff(plan.tas_mps) / np.diff(plan.time_s)
@@ -149,7 +157,8 @@ def pilot_card_text(plan, cue_s=15.0):
         kcas = float(mps_to_kt(plan.cas_mps[k]))
         dist_ft = float(m_to_ft(np.hypot(plan.north_m[k], plan.east_m[k])))
         lines.append(f"{int(t // 60):2d}:{int(t % 60):02d}  {kcas:5.1f}±{CAS_TOLERANCE_KT:.0f}  "
-                     f"{_bank_cue(plan.bank_deg[k]):>5}  {_heading_cue(plan, k):03.0f}°  "
+                     + (f"{kias[k]:5.1f} " if kias is not None else "")
+                     + f"{_bank_cue(plan.bank_deg[k]):>5}  {_heading_cue(plan, k):03.0f}°  "
                      + (f"{_magnetic_deg(plan, _heading_cue(plan, k)):03.0f}M  " if magnetic
                         else "")
                      + f"{dist_ft:6.0f} ft {_bearing_deg(plan, k):03.0f}°  "
@@ -165,27 +174,9 @@ def write_pilot_card(plan, png_path=None, txt_path=None, cue_s=15.0):
         Path(txt_path).write_text(text)
         written.append(Path(txt_path))
     if png_path is not None:
-        from matplotlib.figure import Figure
+        from pitotcal.maneuvers.card import draw_card
 
-        rows = text.splitlines()
-        height = 2.9 + 0.135 * len(rows)
-        fig = Figure(figsize=(8.27, height))
-        # top: the speed trace with its tolerance band, what the pilot is judged against
-        ax = fig.add_axes([0.09, 1 - 2.1 / height, 0.8, 1.8 / height])
-        kt = mps_to_kt(plan.cas_mps)
-        ax.fill_between(plan.time_s, kt - CAS_TOLERANCE_KT, kt + CAS_TOLERANCE_KT,
-                        color="tab:blue", alpha=0.2, label=f"±{CAS_TOLERANCE_KT:.0f} KCAS")
-        ax.plot(plan.time_s, kt, color="tab:blue", label="target KCAS")
-        ax2 = ax.twinx()
-        ax2.plot(plan.time_s, plan.bank_deg, color="tab:red", lw=0.8, label="bank")
-        ax2.set_ylabel("bank, deg (+right)", color="tab:red")
-        ax.set_xlabel("time, s")
-        ax.set_ylabel("KCAS")
-        ax.grid(alpha=0.3)
-        ax.legend(loc="upper left", fontsize=8)
-        fig.text(0.04, 1 - 2.65 / height, text, family="monospace", fontsize=8,
-                 va="top")
-        fig.savefig(png_path, dpi=110)
+        draw_card(plan, text, png_path)
         written.append(Path(png_path))
     return written
 

@@ -14,30 +14,22 @@
 
 import logging
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
-from pitotcal.maneuvers.ocp import ManeuverProblem, PathSolution, turn_radius_m
+from pitotcal.maneuvers.ocp import TURNS, ManeuverProblem, PathSolution, turn_radius_m
 from pitotcal.maneuvers.profiles import make_schedule
 
 from pitotcal.core.checks import integer, number, option_dict, positive
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
-from pitotcal.core.plan import PROFILES, TURNS, Plan
+from pitotcal.core.plan import PROFILES, Plan
 from pitotcal.core.scenario import T2_PLAN
 from pitotcal.core.units import G0_MPS2, RHO0_KGM3, kt_to_mps, mps_to_kt, wind_vector_mps
 
-__all__ = [
-    "MAX_ITER",
-    "MAX_NODES",
-    "ManeuverProblem",
-    "PathSolution",
-    "check_converged",
-    "plan_maneuver",
-    "turn_radius_m",
-    "wind_vector_mps",
-]
+__all__ = ["MAX_ITER", "MAX_NODES", "ManeuverProblem", "PathSolution", "check_converged",
+           "plan_maneuver", "turn_radius_m", "wind_vector_mps"]
 
 log = logging.getLogger(__name__)
 
@@ -134,7 +126,8 @@ def _turn_available(schedule, bank_max_rad):
 
 
 def _where(schedule):
-    return "dwell" if len(schedule.levels_qc_pa) == 2 else "third of the q range"
+    # two groups: two-speed's dwells, or a designed schedule's end levels
+    return "dwell" if len(schedule.groups) == 2 else "third of the q range"
 
 
 def _check_node_count(req):
@@ -172,18 +165,29 @@ def _check_turns(req, schedule):
         f"at {req.bank_max_deg:g}° bank: needs at least {np.ceil(hi):.0f} s", param="duration_s")
 
 
-def _feasible_schedule(req):
-    """The schedule of a request that passes the analytic checks (PlanInfeasibleError else)."""
+def _feasible_schedule(req, design=None):
+    """The schedule of a request that passes the analytic checks (PlanInfeasibleError else),
+    and the request; `design` (maneuvers.design_request.DesignOptions): the designed schedule."""
     _check_node_count(req)
-    schedule = req.schedule()
+    extra = {}
+    if design is not None:
+        from pitotcal.maneuvers.design_request import optimal_schedule
+
+        found, bank_deg, duration_s, extra = optimal_schedule(req, design)
+        req = replace(req, profile="optimal", bank_max_deg=bank_deg, duration_s=duration_s)
+        _check_node_count(req)
+        schedule = found.schedule
+    else:
+        schedule = req.schedule()
     tas_min = schedule.tas_mps.min()
     if req.wind_speed_mps >= 0.9 * tas_min:
         raise PlanInfeasibleError(
             f"wind_speed_mps {req.wind_speed_mps:g} is too strong to hold position at "
             f"{req.cas_min_kt:g} KCAS: it must be below {0.9 * tas_min:.1f} m/s",
             param="wind_speed_mps")
-    _check_turns(req, schedule)
-    return schedule
+    if design is None:          # the design only scores schedules that turn enough
+        _check_turns(req, schedule)
+    return schedule, req, extra
 
 
 def _unconverged(status, iterations, n_nodes, max_iter, during=""):
@@ -278,7 +282,7 @@ def _solve(req, schedule, ipopt_options):
     return sol
 
 
-def _build_plan(req, schedule, sol):
+def _build_plan(req, schedule, sol, extra):
     settings = {
         "profile": req.profile, "cas_min_kt": req.cas_min_kt, "cas_max_kt": req.cas_max_kt,
         "radius_m": req.radius_m, "altitude_m": req.altitude_m, "duration_s": req.duration_s,
@@ -293,6 +297,7 @@ def _build_plan(req, schedule, sol):
     if schedule.levels_qc_pa:
         settings["levels_qc_pa"] = [round(q, 3) for q in schedule.levels_qc_pa]
     settings["coverage_runs"] = [[list(run) for run in runs] for runs in schedule.groups]
+    settings.update(extra)
     return Plan(time_s=schedule.time_s, north_m=sol.north_m, east_m=sol.east_m,
                 alt_m=np.full(schedule.time_s.size, req.altitude_m),
                 heading_deg=np.degrees(sol.heading_rad), bank_deg=np.degrees(sol.bank_rad),
@@ -301,13 +306,22 @@ def _build_plan(req, schedule, sol):
                 iterations=sol.iterations)
 
 
+def _design_options(design, design_options):
+    """The checked options of an optimal design; None for the paper's profiles."""
+    if _choice("design", design, ("paper", "optimal")) == "paper":
+        return None
+    from pitotcal.maneuvers.design_request import checked_options
+    return checked_options(design_options)
+
+
 def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
                   cas_max_kt=T2_PLAN["cas_max_kt"], radius_m=T2_PLAN["radius_m"],
                   altitude_m=T2_PLAN["altitude_m"], duration_s=T2_PLAN["duration_s"],
                   bank_max_deg=T2_PLAN["bank_max_deg"], wind_speed_mps=T2_PLAN["wind_speed_mps"],
                   wind_from_deg=T2_PLAN["wind_from_deg"], *, roll_rate_max_dps=None,
                   accel_max_mps2=None, levels=4, return_leg=False, turn="right", dt_s=1.0,
-                  margin_m=1.0, heading_margin_deg=15.0, max_iter=MAX_ITER, ipopt_options=None):
+                  margin_m=1.0, heading_margin_deg=15.0, max_iter=MAX_ITER, ipopt_options=None,
+                  design="paper", design_options=None):
     """Plan a calibration maneuver: fixed q(t) schedule, optimised lateral path.
 
     Parameters
@@ -333,8 +347,8 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         Step-pause levels, equally spaced in q.
     return_leg : bool
         Continuous profile: sweep back down to cas_min in the second half.
-    turn : {"right", "left"}
-        Turn direction.
+    turn : {"right", "left", "both"}
+        Turn direction; "both" alternates from one coverage group to the next.
     dt_s : float
         Node spacing of the plan, s.
     margin_m : float
@@ -345,6 +359,9 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         IPOPT's iteration limit.
     ipopt_options : dict, optional
         Passed to IPOPT (on top of `max_iter`).
+    design, design_options : {"paper", "optimal"}, dict or maneuvers.design_request.DesignOptions
+        "optimal": the speed schedule designed for information (maneuvers.design) replaces
+        `profile`'s (the plan's profile is then "optimal"), with these options.
 
     Returns
     -------
@@ -362,13 +379,6 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         A malformed argument, or IPOPT failing in a way that proves nothing about the request
         (e.g. its iteration limit): the message says what failed and what to change.
 
-    Notes
-    -----
-    Analytic checks run before any CasADi graph is built: cas_min < cas_max, the acceleration
-    limit against the duration, the turn available at full bank against 360 deg per third,
-    and the still-air turn radius V_max^2 / (g tan(bank_max)) against the radius. When IPOPT
-    still fails, a second solve that minimises the radius names the smallest radius that fits.
-
     Example
     -------
     >>> plan = plan_maneuver()           # the T-2 case: 70-100 KCAS, 926 m, 240 s
@@ -380,5 +390,10 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
                    accel_max_mps2, levels, return_leg, turn, dt_s, margin_m, heading_margin_deg,
                    max_iter)
     ipopt_options = None if ipopt_options is None else option_dict("ipopt_options", ipopt_options)
-    schedule = _feasible_schedule(req)
-    return _build_plan(req, schedule, _solve(req, schedule, ipopt_options))
+    options = _design_options(design, design_options)
+    schedule, req, extra = _feasible_schedule(req, options)
+    sol = _solve(req, schedule, ipopt_options)
+    if options is not None:
+        from pitotcal.maneuvers.design_request import record_prediction
+        extra = record_prediction(extra, schedule, sol, req, options)
+    return _build_plan(req, schedule, sol, extra)

@@ -26,7 +26,7 @@ from pitotcal.core.units import (
     isa_density_kgm3,
 )
 
-__all__ = ["PROFILES", "Schedule", "coverage_groups", "make_schedule"]
+__all__ = ["PROFILES", "Schedule", "coverage_groups", "dwell_schedule", "make_schedule"]
 
 
 @dataclass(frozen=True)
@@ -136,18 +136,28 @@ def _stepped_q(q_range, levels, duration_s, tas_per_cas, accel_max_mps2, dt_s):
     if n_levels < 2:
         raise PitotcalError(f"levels {levels} must be at least 2", param="levels")
     level_q = q_min + (q_max - q_min) * np.arange(n_levels) / (n_levels - 1)
+    return _dwell_q(level_q, np.full(n_levels, 1.0 / n_levels), duration_s, tas_per_cas,
+                    accel_max_mps2, dt_s)
+
+
+def _dwell_q(level_q, fractions, duration_s, tas_per_cas, accel_max_mps2, dt_s):
+    """Node times, q and the levels of dwells at `level_q` (in flying order, repeats allowed)
+    sharing the time the ramps leave in proportion to `fractions`, joined by ramps at the
+    acceleration limit (TAS linear in time)."""
+    level_q = np.asarray(level_q, dtype=float)
+    n_levels = level_q.size
     level_tas = incompressible_cas_mps(level_q) * tas_per_cas
-    ramps = np.diff(level_tas) / accel_max_mps2
-    dwell = (duration_s - ramps.sum()) / n_levels
+    ramps = np.abs(np.diff(level_tas)) / accel_max_mps2
+    dwells = (duration_s - ramps.sum()) * np.asarray(fractions, dtype=float) / np.sum(fractions)
     # a dwell shorter than one node spacing is no dwell at all
-    if dwell < dt_s:
-        need_s = ramps.sum() + n_levels * dt_s
+    if dwells.min() < dt_s:
+        need_s = ramps.sum() + dt_s * np.sum(fractions) / np.min(fractions)
         raise PlanInfeasibleError(
             f"duration_s {duration_s:g} s is too short for {n_levels} levels at the "
             f"{accel_max_mps2:g} m/s^2 acceleration limit: needs at least "
             f"{np.ceil(need_s):.0f} s", param="duration_s")
-    segments = [dwell]
-    for ramp in ramps:
+    segments = [dwells[0]]
+    for ramp, dwell in zip(ramps, dwells[1:]):
         segments += [ramp, dwell]
     time_s, counts = _segment_grid(segments, dt_s)
     qc = np.empty_like(time_s)
@@ -162,6 +172,43 @@ def _stepped_q(q_range, levels, duration_s, tas_per_cas, accel_max_mps2, dt_s):
             qc[node:node + count] = incompressible_qc_pa(tas / tas_per_cas)
         node += count
     return time_s, qc, tuple(float(v) for v in level_q)
+
+
+def dwell_schedule(level_q, fractions, duration_s, *, altitude_m, accel_max_mps2=1.0,
+                   dt_s=1.0, covered=None, profile="optimal"):
+    """A schedule of dwells at given impact pressures, in flying order (the designed ones).
+
+    Parameters
+    ----------
+    level_q : sequence of float
+        Dwell levels, Pa, in the order flown; a level may come back (a later dwell).
+    fractions : sequence of float
+        Share of the dwell time (what the ramps at `accel_max_mps2` leave) of each dwell.
+    duration_s : float
+    altitude_m, accel_max_mps2, dt_s :
+        As `make_schedule`.
+    covered : sequence of float, optional
+        The levels whose dwells (together) must turn the heading through 360 deg: one coverage
+        group each. Default: the lowest and the highest level.
+    profile : str
+        Name kept in the schedule.
+
+    Returns
+    -------
+    Schedule
+        ``levels_qc_pa`` is the flying order of the dwells.
+    """
+    rho = float(isa_density_kgm3(altitude_m))
+    tas_per_cas = np.sqrt(RHO0_KGM3 / rho)
+    time_s, qc, level_q = _dwell_q(level_q, fractions, duration_s, tas_per_cas,
+                                   accel_max_mps2, dt_s)
+    covered = (min(level_q), max(level_q)) if covered is None else covered
+    groups = tuple(_runs(np.isclose(qc, q, rtol=1e-9, atol=1e-6)) for q in covered)
+    cas = incompressible_cas_mps(qc)
+    tas = cas * tas_per_cas
+    return Schedule(profile=profile, time_s=time_s, cas_mps=cas, tas_mps=tas, qc_pa=qc,
+                    accel_mps2=np.diff(tas) / np.diff(time_s), groups=groups,
+                    levels_qc_pa=level_q, rho_kgm3=rho)
 
 
 def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,

@@ -11,7 +11,7 @@ and `StudyInterrupted` is raised. `rerun("coverage", 17, seed=0)` repeats run 17
 import logging
 import time
 
-from pitotcal.core.checks import integer
+from pitotcal.core.checks import choice, integer
 from pitotcal.core.errors import PitotcalError
 from pitotcal.io.jsonfile import write_json
 
@@ -19,6 +19,7 @@ from .budget_study import STUDY as BUDGET
 from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
 from .legs_study import STUDY as LEGS
+from .design_study import STUDY as DESIGN
 from .maneuvers_study import STUDY as MANEUVERS
 from .real_alfa import STUDY as REAL_ALFA
 from .runner import RunsInterrupted, count_errors, output_folder, write_table
@@ -33,7 +34,7 @@ log = logging.getLogger(__name__)
 
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
-                               PEERS, LEGS, BUDGET)}
+                               PEERS, LEGS, DESIGN, BUDGET)}
 
 
 class StudyInterrupted(KeyboardInterrupt):
@@ -57,7 +58,7 @@ def get_study(name):
 
 
 def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=None,
-              quick=False, progress=None, data_dir=None):
+              quick=False, progress=None, data_dir=None, engine="own"):
     """Run study `name` and write DIR/NAME.csv, DIR/NAME.json and DIR/NAME*.png.
 
     Parameters
@@ -78,6 +79,8 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
         A small grid for tests and smoke runs.
     data_dir : str or Path, optional
         `real-alfa`: the folder of the ALFA CSVs (`pitotcal.io.alfa.find_alfa_data`).
+    engine : {"own", "jsbsim"}
+        The flight model of a simulating study that offers more than its own (`coverage`).
 
     Returns
     -------
@@ -95,7 +98,8 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
     settings = StudySettings(runs=_check_runs(runs), seed=integer("seed", seed, 0),
                              quick=bool(quick),
                              workers=workers, scheduler=scheduler, progress=progress,
-                             data_dir=None if data_dir is None else str(data_dir))
+                             data_dir=None if data_dir is None else str(data_dir),
+                             engine=_check_engine(study, engine))
     out = output_folder(out_dir, f"{name}.csv, {name}.json and {name}*.png")
     start = time.perf_counter()
     try:
@@ -119,19 +123,42 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
     return summary
 
 
-def rerun(name, run_index, *, runs=None, seed=0, quick=False, data_dir=None):
+def rerun(name, run_index, *, runs=None, seed=0, quick=False, data_dir=None, engine="own"):
     """Repeat run `run_index` of study `name` alone, in process: its table rows.
 
-    Give the same `runs`, `seed` and `quick` as the study, so the cases line up.
+    Give the same `runs`, `seed`, `quick` and `engine` as the study, so the cases line up.
     """
+    study = get_study(name)
     settings = StudySettings(runs=_check_runs(runs), seed=integer("seed", seed, 0),
                              quick=bool(quick),
-                             data_dir=None if data_dir is None else str(data_dir))
-    return get_study(name).repeat(settings, run_index)
+                             data_dir=None if data_dir is None else str(data_dir),
+                             engine=_check_engine(study, engine))
+    return study.repeat(settings, run_index)
+
+
+# The most runs one study takes: its cases, futures and rows are held in memory (~10 kB a
+# run), and 1e5 runs of ~0.3 s already take over 4 hours on 2 cores; split larger ones by --seed.
+MAX_RUNS = 100_000
+
+
+def _check_engine(study, engine):
+    """`engine` if the study flies it (every study flies the own model)."""
+    engine = choice("engine", engine, ("own", "jsbsim"))
+    offered = getattr(study, "engines", ("own",))
+    if engine not in offered:
+        raise PitotcalError(f"engine {engine}: study {study.name} flies only "
+                            f"{', '.join(offered)}", param="engine")
+    return engine
 
 
 def _check_runs(runs):
-    return None if runs is None else integer("runs", runs, 1)
+    if runs is None:
+        return None
+    runs = integer("runs", runs, 1)
+    if runs > MAX_RUNS:
+        raise PitotcalError(f"runs {runs} is more than one study takes ({MAX_RUNS}, held in "
+                            "memory): run several studies with different --seed", param="runs")
+    return runs
 
 
 def _common_summary(study, settings, rows, n_runs, elapsed_s):
@@ -142,7 +169,7 @@ def _common_summary(study, settings, rows, n_runs, elapsed_s):
             "n_not_converged": sum(1 for r in rows if r.get("success") is False),
             "errors": count_errors(rows), "seed": settings.seed, "quick": settings.quick,
             "workers": "scheduler" if settings.scheduler else settings.workers,
-            "elapsed_s": round(elapsed_s, 2), "partial": False}
+            "engine": settings.engine, "elapsed_s": round(elapsed_s, 2), "partial": False}
 
 
 def _write_partial(study, settings, stop, out, elapsed_s):

@@ -63,6 +63,8 @@ def fly(plan_kwargs=None, sim_kwargs=None, seed=0):
 def _fly_cached(plan_key, sim_key, seed):
     from pitotcal.maneuvers import simulate
     sim = json.loads(sim_key)
+    if sim.pop("engine", "own") == "jsbsim":
+        from pitotcal.maneuvers.jsbsim_flight import simulate_jsbsim as simulate
     for name in ("k", "wind_drift_mps2"):      # JSON turned tuples into lists
         if name in sim:
             sim[name] = tuple(sim[name])
@@ -118,9 +120,11 @@ def first_seconds(flight, seconds):
 
 
 def truth_delta_v_kt(truth, vi_kt):
-    """The true ΔV (kt) of a simulator `Truth` at indicated `vi_kt`."""
+    """The true ΔV (kt) of a simulator `Truth` at indicated `vi_kt`, by the airspeed law of
+    its air data (the standard CAS law for compressible truth)."""
     model = get_model(truth.model)
-    return delta_v_kt(model, [truth.parameters[p] for p in model.params], vi_kt)
+    return delta_v_kt(model, [truth.parameters[p] for p in model.params], vi_kt,
+                      getattr(truth, "air_data", "incompressible"))
 
 
 def vi_grid_kt(qci_pa, n=N_DV_GRID):

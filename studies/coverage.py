@@ -19,8 +19,11 @@ PARAMETERS = ("k1", "k2", "wind_speed_mps", "wind_from_deg")
 TURBULENCE_MPS = 1.0     # moderate: where plain bounds are known to be too small (docs/measured.md)
 
 
-def task(seed, turbulence_mps=TURBULENCE_MPS, model="inverse"):
-    return run_fly_identify(seed, sim={"turbulence_mps": turbulence_mps}, model=model)
+def task(seed, turbulence_mps=TURBULENCE_MPS, model="inverse", engine="own"):
+    sim = {"turbulence_mps": turbulence_mps}
+    if engine != "own":
+        sim["engine"] = engine
+    return run_fly_identify(seed, sim=sim, model=model)
 
 
 def cases(runs, quick):
@@ -124,4 +127,5 @@ def figure(rows, summary):
 
 STUDY = MonteCarloStudy(
     "coverage", "2-σ coverage of the truth in turbulence (corrected vs plain bounds)",
-    task, cases, summarize, plot, headline, default_runs=200, quick_runs=4)
+    task, cases, summarize, plot, headline, default_runs=200, quick_runs=4,
+    engines=("own", "jsbsim"))

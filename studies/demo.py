@@ -27,8 +27,11 @@ log = logging.getLogger(__name__)
 
 # "Light turbulence, realistic sensors" (issue 4): the simulator's defaults, written out here
 # so the demo does not change silently when they do.
+# Compressible truth, so the flight carries the static port and OAT and the demo shows the
+# default calibration (the standard CAS law, ΔV = ΔV_pc).
 DEMO_SIM = {"model": "inverse", "k": TRUE_K["inverse"], "turbulence_mps": 0.5, "rate_hz": 50.0,
-            "qc_noise_pa": 0.5, "gps_rate_hz": 5.0, "gps_noise_mps": 0.05}
+            "qc_noise_pa": 0.5, "gps_rate_hz": 5.0, "gps_noise_mps": 0.05,
+            "air_data": "compressible"}
 
 
 @dataclass(frozen=True)

@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+from pitotcal.io.atomic import save_figure
+
 __all__ = ["new_figure", "plain_log_ticks", "save"]
 
 
@@ -17,7 +19,7 @@ def new_figure(nrows=1, ncols=1, size=(6.0, 4.0)):
 def save(fig, out_dir, filename):
     """Save `fig` as out_dir/filename (110 dpi); the path as text."""
     path = Path(out_dir) / filename
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     return str(path)
 
 

@@ -24,6 +24,7 @@ from pitotcal.core.checks import wrap_deg
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import incompressible_cas_mps, mps_to_kt, wind_polar
 from pitotcal.io.alfa import find_alfa_data, read_alfa_csv, read_alfa_flight
+from pitotcal.io.atomic import atomic_open
 
 from .baselines import ardupilot_ratio_from_k1, k1_from_ardupilot_ratio
 from .peer_ardupilot import ardupilot_autocal
@@ -225,7 +226,7 @@ def _row(*values):
 
 def _write_tracks(path, ardu, px4, ap):
     """real-alfa_tracks.csv: the peers' estimates and the autopilot's log over time."""
-    with open(path, "w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(["source", "time_s", "k1", "k1_2sigma", "wind_speed_mps", "wind_from_deg"])
         for tr in (ardu, px4):

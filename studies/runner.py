@@ -30,6 +30,7 @@ from pathlib import Path
 
 from pitotcal.core.checks import integer
 from pitotcal.core.errors import PitotcalError
+from pitotcal.io.atomic import atomic_open
 
 __all__ = [
     "SERIAL_BELOW",
@@ -45,6 +46,9 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
+
+# Seconds to reach an existing scheduler (--scheduler) before giving up.
+CONNECT_TIMEOUT_S = 15.0
 
 # Below this many runs the serial path wins: LocalCluster start ~3-5 s vs ~0.2 s per run.
 SERIAL_BELOW = 16
@@ -186,17 +190,45 @@ def _run_dask(jobs, workers, scheduler, progress):
         quiet.setLevel(level)
 
 
+def _connect(Client, scheduler):
+    """A Client of the Dask scheduler at `scheduler`, or one line saying why not.
+
+    The connection runs in a daemon thread with a deadline: a port that answers with something
+    other than Dask's protocol can make distributed wait forever (or try to allocate what a
+    garbage length header asks for), whatever its own timeout says.
+    """
+    import threading
+
+    outcome, timeout_s = {}, CONNECT_TIMEOUT_S
+
+    def connect():
+        try:
+            outcome["client"] = Client(scheduler, timeout=f"{timeout_s}s")
+        except BaseException as exc:        # noqa: BLE001 - reported below, in one line
+            outcome["error"] = exc
+
+    thread = threading.Thread(target=connect, name="dask-connect", daemon=True)
+    thread.start()
+    thread.join(timeout_s + 5.0)
+    if "client" in outcome:
+        return outcome["client"]
+    exc = outcome.get("error")
+    if thread.is_alive():
+        text = f"no Dask answer within {timeout_s:g} s"
+    elif isinstance(exc, KeyboardInterrupt):
+        raise exc
+    else:
+        text = (str(exc).splitlines() or [""])[0] or type(exc).__name__
+    # a typo'd address is bad input: one line, exit 2 (not a distributed traceback)
+    raise PitotcalError(f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
+                        f"({text}); expected e.g. tcp://HOST:8786 with `dask scheduler` "
+                        "running there")
+
+
 def _submit_all(jobs, workers, scheduler, progress, Client, LocalCluster, as_completed):
     cluster = None
     if scheduler is not None:
-        try:
-            client = Client(scheduler)
-        except (OSError, ValueError, TypeError) as exc:
-            # a typo'd address is bad input: one line, exit 2 (not a distributed traceback)
-            text = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise PitotcalError(f"--scheduler {scheduler!r}: cannot connect to a Dask "
-                                f"scheduler ({text}); expected e.g. tcp://HOST:8786 with "
-                                f"`dask scheduler` running there") from None
+        client = _connect(Client, scheduler)
     else:
         n = workers or os.cpu_count() or 1
         # processes, one thread each: CasADi/IPOPT and numpy work best unshared; no dashboard.
@@ -276,7 +308,7 @@ def write_table(rows, path, comments=(), columns=()):
     columns = [c for c in columns if c in present]
     for row in rows:
         columns.extend(k for k in row if k not in columns)
-    with open(path, "w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         fh.writelines(f"# {line}\n" for line in comments)
         writer = csv.DictWriter(fh, fieldnames=columns, restval="")
         writer.writeheader()

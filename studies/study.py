@@ -32,6 +32,9 @@ class StudySettings:
         Where the runs go (`studies.runner.run_cases`).
     data_dir : str or None
         Folder of real flight data (`real-alfa`; see `pitotcal.io.alfa.find_alfa_data`).
+    engine : str
+        The flight model of a simulating study: "own" (pitotcal's) or "jsbsim" (the study's
+        `engines` says which it offers).
     """
 
     runs: int | None = None
@@ -41,6 +44,7 @@ class StudySettings:
     scheduler: str | None = None
     progress: Callable | None = None
     data_dir: str | None = None
+    engine: str = "own"
 
 
 @dataclass(frozen=True)
@@ -111,6 +115,7 @@ class MonteCarloStudy:
     default_runs: int = 10
     quick_runs: int = 1
     columns: tuple = ()
+    engines: tuple = ("own",)
 
     def replicates(self, settings):
         """Replicates per case: the asked `runs`, else the study's default."""
@@ -118,9 +123,16 @@ class MonteCarloStudy:
             return int(settings.runs)
         return self.quick_runs if settings.quick else self.default_runs
 
+    def with_engine(self, cases, settings):
+        """The cases flown by `settings.engine`: each gets an ``engine`` key unless it is the
+        own model (`studies.catalog` checks that the study offers it)."""
+        if settings.engine == "own":
+            return cases
+        return [{**case, "engine": settings.engine} for case in cases]
+
     def collect(self, settings):
         n_rep = self.replicates(settings)
-        cases = self.cases(n_rep, settings.quick)
+        cases = self.with_engine(self.cases(n_rep, settings.quick), settings)
         rows = run_cases(self.task, cases, base_seed=settings.seed, workers=settings.workers,
                          scheduler=settings.scheduler, progress=settings.progress)
         return Collected(rows, len(cases), details=cases, info={"replicates": n_rep},
@@ -131,5 +143,5 @@ class MonteCarloStudy:
         return summary, self.plot(collected.rows, summary, out_dir)
 
     def repeat(self, settings, run_index):
-        cases = self.cases(self.replicates(settings), settings.quick)
+        cases = self.with_engine(self.cases(self.replicates(settings), settings.quick), settings)
         return run_one(self.task, cases, run_index, base_seed=settings.seed)

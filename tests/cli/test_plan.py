@@ -184,3 +184,72 @@ def test_export_refuses_the_downwind_bank(tmp_path, capsys):
         "57.1 m/s ground speed (101 KTAS in 5 m/s wind) banks 31°, over --bank-max-deg 30°: "
         "export a plan with --radius-m at least 575 m\n")
     assert list(tmp_path.iterdir()) == []
+
+
+# --- plan --design optimal (issue 13) --------------------------------------------------------
+
+@pytest.mark.parametrize("argv, message", [
+    (["--stall-kt", "50"], "--stall-kt is for --design optimal"),
+    (["--design", "optimal", "--profile", "two-speed"],
+     "--profile two-speed is for --design paper: --design optimal chooses its own"),
+    (["--design", "optimal", "--return"], "--return is for --design paper"),
+    (["--design", "optimal", "--levels", "3"], "--levels 3 is for --design paper"),
+    (["--design", "optimal", "--stall-kt", "62"],
+     "--stall-kt 62 KCAS leaves --cas-min-kt 70 below 1.2 x the stall speed at 5° bank"),
+    (["--design", "optimal", "--turbulence-mps", "0"], "--turbulence-mps 0 must be > 0"),
+    (["--design", "optimal", "--duration-s", "60"],
+     ("--duration-s 60 s is too short for an optimal design: each end speed must turn 360° at "
+      "30° bank; 134 s is long enough")),
+    (["--design", "optimal", "--check-fraction", "0.7"], "--check-fraction 0.7 must be"),
+])
+def test_design_refusals_exit_2_naming_the_flag(argv, message, tmp_path, capsys):
+    out = tmp_path / "plan.csv"
+    assert main(["plan", *argv, "--no-figures", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pitotcal plan: ") and message in err, err
+    assert not out.exists()
+
+
+def test_design_optimal_card_and_csv_say_why(tmp_path, capsys):
+    out = tmp_path / "opt.csv"
+    assert main(["plan", "--design", "optimal", "--check-fraction", "0", "--no-figures",
+                 "-o", str(out)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0].startswith("optimal plan: 240 s")
+    assert re.fullmatch(r"  design: dwells [LH](-[LH])+ \(low, check, high\), \d+% of the "
+                        r"end-level time low; predicted worst 2σ of ΔV 0\.\d\d kt in 0\.5 m/s "
+                        r"turbulence", printed[2]), printed[2]
+    plan = read_plan(out)
+    s = plan.settings
+    assert s["design"] == "optimal" and s["check_fraction"] == 0.0
+    assert len(set(s["levels_qc_pa"])) == 2 and s["predicted_dv_2sigma_kt"] < 1.0
+    card = (tmp_path / "opt.card.txt").read_text()
+    assert "Designed for information" in card and "predicted dV 2sigma" in card
+
+
+def test_calibration_gives_kias_targets_that_the_correction_maps_back(tmp_path):
+    """--calibration: the card's KIAS at each KCAS target is V_i with V_i + ΔV(V_i) = KCAS."""
+    import json
+
+    from pitotcal.core.models import delta_v_kt, get_model
+
+    result = {"model": "inverse", "parameters": {"k1": {"value": 0.02}, "k2": {"value": -15.0},
+                                                  "wind_speed_mps": {"value": 5.0}}}
+    (tmp_path / "r.json").write_text(json.dumps(result))
+    out = tmp_path / "p.csv"
+    assert main(["plan", "--profile", "two-speed", "--calibration", str(tmp_path / "r.json"),
+                 "--no-figures", "-o", str(out)]) == 0
+    card = (tmp_path / "p.card.txt").read_text().splitlines()
+    assert card[4].endswith("BANK: within 5° of the cue") and card[5].startswith("KIAS: the indicator's reading")
+    head = card.index(next(line for line in card if line.split()[:3] == ["TIME", "KCAS",
+                                                                            "KIAS"]))
+    rows = [line.split() for line in card[head + 1:] if line.strip()]
+    kcas = np.array([float(r[1].split("±")[0]) for r in rows])
+    kias = np.array([float(r[2]) for r in rows])
+    back = kias + delta_v_kt(get_model("inverse"), (0.02, -15.0), kias)
+    np.testing.assert_allclose(back, kcas, atol=0.051)      # one decimal on the card
+    # dp/qc = 0.02 - 15/q_ci > 0 at 100 KCAS: the indicator reads low there (ΔV +0.5 kt)
+    assert kias[-1] < kcas[-1] - 0.3
+    bad = tmp_path / "bad.json"
+    bad.write_text("{}")
+    assert main(["plan", "--calibration", str(bad), "--no-figures", "-o", str(out)]) == 2

@@ -118,3 +118,19 @@ def test_non_finite_truth_coefficient_is_refused(plan_csv, tmp_path, capsys):
     assert main(["simulate", str(plan_csv), "-o", str(tmp_path / "f.csv"), "--k1", "nan"]) == 2
     assert capsys.readouterr().err == "pitotcal simulate: --k1 nan must be a finite number\n"
     assert not (tmp_path / "f.csv").exists()
+
+
+def test_a_plan_beyond_what_plan_makes_is_refused_before_flying(tmp_path, plan_csv, capsys):
+    lines = plan_csv.read_text().splitlines()
+    header = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    col = lines[header].split(",").index("alt_m")
+    cells = lines[header + 3].split(",")
+    cells[col] = "1e6"
+    lines[header + 3] = ",".join(cells)
+    bad = tmp_path / "high.csv"
+    bad.write_text("\n".join(lines) + "\n")
+    assert main(["simulate", str(bad), "-o", str(tmp_path / "f.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (f"pitotcal simulate: {bad}: column alt_m, row 3 (line {header + 4}): 1e+06 "
+                   "is outside -400 to 11000 m (what a plan can hold)")
+    assert not (tmp_path / "f.csv").exists() and not (tmp_path / "f.truth.json").exists()

@@ -104,3 +104,12 @@ def test_bad_arguments(args, error, capsys):
 def test_a_negative_seed_is_refused(capsys):
     assert main(["study", "coverage", "--quick", "--workers", "0", "--seed", "-1"]) == 2
     assert capsys.readouterr().err == "pitotcal study: --seed -1 must be >= 0\n"
+
+
+def test_runs_above_the_cap_are_refused_with_the_cap(capsys):
+    from pitotcal.cli import main
+
+    assert main(["study", "coverage", "--runs", "100000000"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == ("pitotcal study: --runs 100000000 is more than one study takes (100000, "
+                   "held in memory): run several studies with different --seed")

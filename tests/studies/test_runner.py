@@ -1,5 +1,6 @@
 """The Monte Carlo engine: seeds, failed runs as rows, serial and Dask paths give equal rows."""
 
+import contextlib
 import math
 
 import pytest
@@ -87,5 +88,37 @@ def test_table_comments_and_leading_columns(tmp_path):
 
 @pytest.mark.parametrize("address", ["nonsense", "tcp://127.0.0.1"])
 def test_bad_scheduler_address_is_one_line_error(address):
+    with pytest.raises(ValueError, match=f"--scheduler '{address}': cannot connect"):
+        run_cases(echo_task, _cases(2), scheduler=address)
+
+
+@pytest.fixture
+def not_dask_port():
+    """A local port that answers a connection with bytes that are not Dask's protocol."""
+    import socket
+    import threading
+
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen()
+    held = []
+
+    def serve():
+        with contextlib.suppress(OSError):
+            while True:
+                conn, _ = server.accept()
+                conn.sendall(b"\xff" * 64)      # a length header of ~2**64: garbage
+                held.append(conn)
+
+    threading.Thread(target=serve, daemon=True).start()
+    yield server.getsockname()[1]
+    server.close()
+
+
+def test_a_port_that_is_not_dask_is_one_line_error_not_a_hang(not_dask_port, monkeypatch):
+    from pitotcal.studies import runner
+
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1.0)
+    address = f"tcp://127.0.0.1:{not_dask_port}"
     with pytest.raises(ValueError, match=f"--scheduler '{address}': cannot connect"):
         run_cases(echo_task, _cases(2), scheduler=address)

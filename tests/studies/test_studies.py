@@ -32,6 +32,10 @@ LEAN = {  # name -> (runs, study columns, study summary keys, headline pattern)
                                          "parameters", "n_runs_used"},
                  (r"truth inside the corrected 2σ bounds \d+(\.\d)?% of the time, inside the "
                  r"plain Hessian ones \d+(\.\d)?% \(16 intervals from 4 runs\)")),
+    "design": (1, {"design", "duration_s", "dv_2sigma_range_kt", "dv_inside_range"},
+               {"by_design", "reference", "optimal_gain_at_240s"},
+               (r"at 240 s optimal \d\.\d\d kt vs two-speed \d\.\d\d kt worst-row 2σ of ΔV "
+                r"over 72-98 KIAS \([+-]\d+% gain\); two-speed's value reached in .+")),
     "wind": (1, {"profile", "wind_speed_mps", "wind_from_deg"}, {"by_profile"},
              (r"estimated vs flown wind within \d\.\d\d kt and \d+\.\d° RMS \(worst profile\), "
              r"truth inside 2σ in \S+ of the estimates \(paper: 0.5 kt, 4°\)")),

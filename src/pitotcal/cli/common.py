@@ -3,6 +3,7 @@
 A command module imports from here, never from another command's module.
 """
 
+import os
 from pathlib import Path
 
 # Outside air temperatures anyone calibrates in, degC (ISA at 15 km is -56.5 degC).
@@ -33,7 +34,28 @@ def check_output(flag, out, source, what):
     out = Path(out)
     if out.is_dir():
         raise PitotcalError(f"{flag} {out} is a folder: give the file to write")
-    if out.resolve() == Path(source).resolve():
+    if out.resolve() == Path(source).resolve() or _same_file(out, source):
         raise PitotcalError(f"{flag} {out}: would overwrite the input {what}")
     if not out.resolve().parent.is_dir():
         raise PitotcalError(f"{flag} {out}: directory {out.parent} does not exist")
+
+
+def check_distinct(outputs):
+    """Refuse two outputs at one path (hard links included): `outputs` maps flag -> path or
+    None (not asked for)."""
+    from pitotcal.core.errors import PitotcalError
+
+    given = [(flag, Path(path)) for flag, path in outputs.items() if path is not None]
+    for i, (flag, path) in enumerate(given):
+        for other, other_path in given[:i]:
+            if path.resolve() == other_path.resolve() or _same_file(path, other_path):
+                raise PitotcalError(f"{flag} {path}: same file as {other} {other_path}; "
+                                    "give each output its own path")
+
+
+def _same_file(a, b):
+    """Both exist and are one file (a hard link or a symlink to it counts)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False

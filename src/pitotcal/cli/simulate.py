@@ -38,9 +38,16 @@ def add_parser(subparsers):
     s.add_argument("--gps-noise-mps", type=float, default=0.05,
                    help="GPS velocity noise std (0.05)")
     s.add_argument("--gps-latency-s", type=float, default=0.0, help="GPS velocity latency (0)")
-    g.add_argument("--air-data", default="incompressible",
+    g.add_argument("--air-data", default=None,
                    help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
-                        "the paper's eq. 2; default) or compressible (isentropic, ISA p and T)")
+                        "the paper's eq. 2; default) or compressible (isentropic, ISA p and T); "
+                        "JSBSim's is always compressible")
+    e = p.add_argument_group("flight model")
+    e.add_argument("--engine", default="own", choices=("own", "jsbsim"),
+                   help="own: pitotcal's point-mass model (fast, default); jsbsim: the JSBSim "
+                        "six-degree-of-freedom model, its atmosphere and Milspec turbulence")
+    e.add_argument("--aircraft", default=None,
+                   help="JSBSim aircraft (default c172x, the Cessna 172); --engine jsbsim only")
     a = p.add_argument_group(
         "air-data sensors (issue 9)",
         "with any of these the flight also logs ps_pa, oat_k or tat_k, and rh_pct")
@@ -58,6 +65,19 @@ def add_parser(subparsers):
                    help="constant GPS velocity bias north, east, down, m/s")
     p.set_defaults(run=run)
     return p
+
+
+def _air_sensor_option(args):
+    """{"air_sensors": ...} for `simulate` when any was given (own engine only), else {}."""
+    sensors = _air_sensors(args)
+    if sensors is None:
+        return {}
+    if args.engine != "own":
+        from pitotcal.core.errors import PitotcalError
+        raise PitotcalError("the air-data sensor options (--tat-recovery, --rh-percent, "
+                            "--probe-arm-m, --oat-bias-k, --gps-bias-mps) apply to --engine own "
+                            "only")
+    return {"air_sensors": sensors}
 
 
 def _air_sensors(args):
@@ -109,18 +129,38 @@ def _outputs(args):
     return out, truth_out
 
 
+def _engine(args):
+    """The simulate function of --engine, with --aircraft (refused where it means nothing)."""
+    from functools import partial
+
+    from pitotcal.core.errors import PitotcalError
+
+    if args.engine == "own":
+        if args.aircraft is not None:
+            raise PitotcalError("--aircraft: only --engine jsbsim flies an aircraft model")
+        from pitotcal.maneuvers.simulator import simulate
+
+        return simulate
+    if args.air_data not in (None, "compressible"):
+        raise PitotcalError(f"--air-data {args.air_data}: JSBSim's impact pressure is its own "
+                            "isentropic total pressure minus static (compressible)")
+    from pitotcal.maneuvers.jsbsim_engine import DEFAULT_AIRCRAFT
+    from pitotcal.maneuvers.jsbsim_flight import simulate_jsbsim
+
+    return partial(simulate_jsbsim, aircraft=args.aircraft or DEFAULT_AIRCRAFT)
+
+
 def run(args):
     import warnings
 
     from pitotcal.io import write_flight_csv
     from pitotcal.io.plan_csv import read_plan
-    from pitotcal.maneuvers.simulator import simulate
     from pitotcal.maneuvers.truth import tracking_warnings, write_truth_json
 
     model, k = _true_k(args)
     out, truth_out = _outputs(args)
     plan = read_plan(args.plan)
-    flight, truth = simulate(
+    flight, truth = _engine(args)(
         plan, seed=args.seed, model=model.name, k=k, wind_speed_mps=args.wind_speed_mps,
         wind_from_deg=args.wind_from_deg,
         wind_drift_mps2=(args.wind_drift_n_mps2, args.wind_drift_e_mps2),
@@ -129,7 +169,8 @@ def run(args):
         qc_quantization_pa=args.qc_quantization_pa, qc_bias_pa=args.qc_bias_pa,
         qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
-        gps_latency_s=args.gps_latency_s, air_data=args.air_data, air_sensors=_air_sensors(args))
+        gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
+        **_air_sensor_option(args))
     write_flight_csv(flight, out, comments={"plan": str(args.plan)})
     truth_path = write_truth_json(truth, truth_out)
     print(f"wrote {args.output} ({flight.n} samples, {flight.time_s[-1] - flight.time_s[0]:.0f} s)"

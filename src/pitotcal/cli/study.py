@@ -29,6 +29,9 @@ def add_parser(subparsers):
     p.add_argument("--data", dest="data_dir", default=None, metavar="DIR",
                    help="real-alfa: folder of the ALFA flight CSVs (default: "
                         "$PITOTCAL_ALFA_DATA, else ./alfa-carbonz)")
+    p.add_argument("--engine", default="own", choices=("own", "jsbsim"),
+                   help="flight model of the simulated runs: own (default) or jsbsim "
+                        "(JSBSim's c172x; coverage only)")
     p.add_argument("--run-index", type=int, default=None, metavar="I",
                    help="repeat run I alone (same --runs/--seed/--quick as the study); "
                         "prints its rows as JSON")
@@ -43,7 +46,8 @@ def run(args):
     try:
         summary = run_study(args.name, runs=args.runs, out_dir=args.out_dir, seed=args.seed,
                             workers=args.workers, scheduler=args.scheduler, quick=args.quick,
-                            progress=_progress(args.name), data_dir=args.data_dir)
+                            progress=_progress(args.name), data_dir=args.data_dir,
+                            engine=args.engine)
     except StudyInterrupted as stop:
         s = stop.summary
         if sys.stderr.isatty():
@@ -68,7 +72,7 @@ def _repeat(args, rerun):
     import json
 
     rows = rerun(args.name, args.run_index, runs=args.runs, seed=args.seed, quick=args.quick,
-                 data_dir=args.data_dir)
+                 data_dir=args.data_dir, engine=args.engine)
     print(json.dumps(rows, indent=2, default=str))
     return 1 if any(r.get("error") for r in rows) else 0
 

@@ -12,13 +12,24 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     import numpy as np
 
-__all__ = ["PLAN_COLUMNS", "PROFILES", "TURNS", "Plan"]
+__all__ = ["ALTITUDE_RANGE_M", "PLAN_COLUMNS", "PLAN_RANGES", "PROFILES", "TURNS", "Plan"]
 
 PLAN_COLUMNS = ("time_s", "north_m", "east_m", "alt_m", "heading_deg", "bank_deg",
                 "tas_mps", "cas_mps", "qc_pa")
 # Airspeed schedules (maneuvers/profiles.py, paper section IV) and turn directions.
 PROFILES = ("continuous", "step-pause", "two-speed")
 TURNS = ("right", "left")
+
+# The altitudes `pitotcal plan` plans for (ISA troposphere, where the air data hold), m.
+ALTITUDE_RANGE_M = (-400.0, 11000.0)
+# What a plan's columns can hold (a plan CSV read back is checked against these), SI: a test
+# area of at most 100 km, banks the planner allows (<= 75 deg), subsonic airspeeds (the
+# heading is unwrapped, so any finite value).
+PLAN_RANGES = {
+    "north_m": (-1e5, 1e5), "east_m": (-1e5, 1e5), "alt_m": ALTITUDE_RANGE_M,
+    "bank_deg": (-75.0, 75.0),
+    "tas_mps": (0.0, 300.0), "cas_mps": (0.0, 300.0), "qc_pa": (0.0, 1e5),
+}
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from pitotcal.io.atomic import atomic_open
+
 __all__ = ["json_ready", "write_json"]
 
 
@@ -30,8 +32,9 @@ def json_ready(value):
 
 
 def write_json(path, obj):
-    """Write `obj` (after `json_ready`) as indented, strictly valid JSON; returns the path."""
-    with open(path, "w") as f:
+    """Write `obj` (after `json_ready`) as indented, strictly valid JSON, whole or not at all
+    (`pitotcal.io.atomic`); returns the path."""
+    with atomic_open(path, "w") as f:
         json.dump(json_ready(obj), f, indent=2, allow_nan=False)
         f.write("\n")
     return path

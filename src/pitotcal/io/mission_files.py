@@ -10,6 +10,8 @@ https://docs.qgroundcontrol.com/master/en/qgc-dev-guide/file_formats/plan.html (
 import json
 from dataclasses import dataclass
 
+from pitotcal.io.atomic import atomic_open
+
 __all__ = ["FRAME_GLOBAL", "FRAME_GLOBAL_RELATIVE_ALT", "FRAME_MISSION", "MAV_CMD",
            "MissionItem", "write_qgc_plan", "write_qgc_wpl"]
 
@@ -52,7 +54,7 @@ def write_qgc_wpl(path, home, items):
                   *(_num(p) for p in item.params),
                   _num(item.lat_deg), _num(item.lon_deg), _num(item.alt_m), 1]
         lines.append("\t".join(str(f) for f in fields))
-    with open(path, "w", encoding="ascii", newline="\n") as f:
+    with atomic_open(path, "w", encoding="ascii", newline="\n") as f:
         f.write("\n".join(lines) + "\n")
     return path
 
@@ -96,7 +98,7 @@ def write_qgc_plan(path, home, items, *, cruise_speed_mps, firmware_type=12, veh
             "items": [_plan_item(seq, item) for seq, item in enumerate(items, start=1)],
         },
     }
-    with open(path, "w", encoding="utf-8") as f:
+    with atomic_open(path, "w", encoding="utf-8") as f:
         json.dump(plan, f, indent=2)
         f.write("\n")
     return path

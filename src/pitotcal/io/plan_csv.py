@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.plan import PLAN_COLUMNS, Plan
+from pitotcal.core.plan import PLAN_COLUMNS, PLAN_RANGES, Plan
+from pitotcal.io.atomic import atomic_open
 
 __all__ = ["read_plan", "write_plan"]
 
@@ -16,7 +17,7 @@ __all__ = ["read_plan", "write_plan"]
 def write_plan(plan, path):
     """Write the plan CSV: `# key: json-value` lines with the settings, then the columns."""
     path = Path(path)
-    with path.open("w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         for key, value in plan.settings.items():
             fh.write(f"# {key}: {json.dumps(value)}\n")
         writer = csv.writer(fh)
@@ -88,6 +89,12 @@ def read_plan(path):
         if bad.size:
             raise PitotcalError(f"{path}: column {name}, {rows[int(bad[0])][1]}: airspeed "
                                 f"{columns[name][bad[0]]:g} m/s must be > 0")
+    for name, (lo, hi) in PLAN_RANGES.items():
+        bad = np.flatnonzero((columns[name] < lo) | (columns[name] > hi))
+        if bad.size:
+            raise PitotcalError(f"{path}: column {name}, {rows[int(bad[0])][1]}: "
+                                f"{columns[name][bad[0]]:g} is outside {lo:g} to {hi:g} "
+                                f"{name.rsplit('_', 1)[1]} (what a plan can hold)")
     span = columns["time_s"][-1] - columns["time_s"][0]
     duration = settings.get("duration_s")
     if isinstance(duration, (int, float)) and abs(span - duration) > max(1e-3 * duration, 0.01):

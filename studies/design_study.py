@@ -1,0 +1,231 @@
+"""`design` (issue 13): the information-optimal speed schedule against the best paper profile.
+
+Two-speed (the best of the paper's profiles in the `maneuvers` study) is flown for 240 s; the
+optimal design (`plan --design optimal`, with its check level, and without it) at several
+flight times. Every flight: T-2 case, 0.5 m/s Dryden turbulence, identified with the inverse
+model; the score is the worst 2σ of ΔV that `identify` reports over 72-98 KIAS and whether the
+truth lies inside ±2σ there (coverage). A replicate uses the same seed for every design and
+time (common random numbers).
+
+Beside the flights, the information bound (pitotcal.core.information) of each case, and of
+the ideal two-point design (speed changes without ramps, the best share of time at each
+end): what no schedule of this flight time can beat under the noise model.
+"""
+
+import numpy as np
+
+from .common import column, fly, group, identify_flight, ok_rows, score, truth_delta_v_kt
+from .figures import new_figure, save
+from .study import MonteCarloStudy
+
+__all__ = ["DESIGNS", "STUDY", "plan_kwargs"]
+
+RANGE_KT = (72.0, 98.0)
+TURBULENCE_MPS = 0.5
+REFERENCE = ("two-speed", 240.0)
+# design -> the plan's keyword arguments besides the duration
+DESIGNS = {
+    "two-speed": {"profile": "two-speed"},
+    "optimal": {"design": "optimal"},
+    "optimal-2-level": {"design": "optimal", "design_options": {"check_fraction": 0.0}},
+}
+DURATIONS_S = (150.0, 180.0, 210.0, 240.0)
+QUICK_DURATIONS_S = (240.0,)
+_GRID = np.linspace(*RANGE_KT, 7)
+
+
+def plan_kwargs(design, duration_s):
+    return {**DESIGNS[design], "duration_s": float(duration_s)}
+
+
+def task(seed, design, duration_s):
+    """Fly and identify one flight of the design; the common score plus the 72-98 KIAS ones."""
+    kwargs = plan_kwargs(design, duration_s)
+    flight, truth = fly(kwargs, {"turbulence_mps": TURBULENCE_MPS}, seed)
+    result = identify_flight(flight)
+    row = score(result, truth, flight)
+    dv, two_sigma = result.delta_v_kt(_GRID)
+    inside = np.abs(dv - truth_delta_v_kt(truth, _GRID)) <= two_sigma
+    row.update({"dv_2sigma_range_kt": float(two_sigma.max()),
+                "dv_inside_range": float(inside.mean())})
+    return row
+
+
+def cases(runs, quick):
+    durations = QUICK_DURATIONS_S if quick else DURATIONS_S
+    designs = ("optimal",) if quick else [d for d in DESIGNS if d != REFERENCE[0]]
+    out = []
+    for r in range(runs):
+        out.append({"design": REFERENCE[0], "duration_s": REFERENCE[1], "seed_offset": r})
+        out += [{"design": d, "duration_s": t, "seed_offset": r}
+                for d in designs for t in durations]
+    return out
+
+
+def predicted_kt(design, duration_s):
+    """The predicted worst-row 2σ of ΔV over 72-98 KIAS (what identify reports) of a case."""
+    from pitotcal.maneuvers.design import predict_plan_band_kt
+
+    from .common import get_plan
+
+    plan = get_plan(**plan_kwargs(design, duration_s))
+    return float(predict_plan_band_kt(plan, TURBULENCE_MPS, _GRID)[0].max())
+
+
+def ideal_bound_kt(duration_s):
+    """The worst-row bounds of the ideal two-point design (instantaneous speed changes, one
+    dwell at each end of 70-100 KCAS, on the T-2 circle), at the best share of time at the low
+    end: (robust, reported-only) kt. Robust: the design criterion, the larger of the reported
+    bound and the actual scatter at each speed. Reported-only: the smallest bound identify
+    could report, reached by a share at which the high-speed scatter exceeds it."""
+    from pitotcal.maneuvers.design import circle_heading_rad, default_noise, predict_band_kt
+    from pitotcal.maneuvers.profiles import dwell_schedule
+
+    from pitotcal.core.scenario import T2_PLAN
+    from pitotcal.core.units import kt_to_mps, incompressible_qc_pa, wind_vector_mps
+
+    q = [float(incompressible_qc_pa(kt_to_mps(T2_PLAN[name]))) for name in ("cas_min_kt",
+                                                                       "cas_max_kt")]
+    wind = wind_vector_mps(T2_PLAN["wind_speed_mps"], T2_PLAN["wind_from_deg"])
+    robust, reported = np.inf, np.inf
+    for share in np.arange(0.3, 0.71, 0.02):
+        s = dwell_schedule(q, [share, 1 - share], duration_s, altitude_m=T2_PLAN["altitude_m"],
+                           accel_max_mps2=1e3)
+        noise = default_noise(TURBULENCE_MPS, T2_PLAN["altitude_m"], s.tas_mps)
+        heading = circle_heading_rad(s, np.radians(25.0))
+        rep, act = predict_band_kt(s, heading, wind, noise, _GRID)
+        robust = min(robust, float(np.maximum(rep, act).max()))
+        reported = min(reported, float(rep.max()))
+    return robust, reported
+
+
+def summarize(rows, cases=None):
+    by_design = {}
+    for (design, duration), rs in group(rows, "design", "duration_s").items():
+        good = ok_rows(rs)
+        two_sigma = column(good, "dv_2sigma_range_kt")
+        entry = {"n_runs": len(rs), "n_ok": len(good),
+                 "dv_2sigma_range_kt": _median(two_sigma),
+                 # standard error of a median, 1.253 sigma / sqrt(n) for a normal sample
+                 "dv_2sigma_range_se_kt": (float(1.253 * np.std(two_sigma) / np.sqrt(len(good)))
+                                           if len(good) > 1 else None),
+                 "coverage": _mean(column(good, "dv_inside_range")),
+                 "dv_err_max_kt_rms": _rms(column(good, "dv_err_max_kt")),
+                 "predicted_kt": round(predicted_kt(design, duration), 3)}
+        entry["ideal_bound_kt"], entry["ideal_reported_only_kt"] = (
+            round(v, 3) for v in ideal_bound_kt(duration))
+        by_design.setdefault(design, {})[str(int(duration))] = entry
+    ref = by_design.get(REFERENCE[0], {}).get(str(int(REFERENCE[1])), {})
+    out = {"by_design": by_design, "range_kt": list(RANGE_KT),
+           "turbulence_mps": TURBULENCE_MPS, "reference": ref}
+    for design, entries in by_design.items():
+        for duration, entry in entries.items():
+            entry["paired_ratio"] = _paired_ratio(rows, design, float(duration))
+    for design in DESIGNS:
+        same = by_design.get(design, {}).get(str(int(REFERENCE[1])))
+        if design == REFERENCE[0] or same is None or same["paired_ratio"] is None:
+            continue
+        out[f"{design}_gain_at_240s"] = round(1.0 - same["paired_ratio"], 3)
+        out[f"{design}_time_to_reference_s"] = _time_to(
+            by_design[design], same["predicted_kt"] / same["paired_ratio"])
+        out[f"{design}_predicted_time_to_reference_s"] = _time_to(
+            by_design[design], ref.get("predicted_kt"))
+    return out
+
+
+def _paired_ratio(rows, design, duration_s):
+    """Geometric mean over seeds of the worst-row 2σ of ΔV of this case over two-speed's at
+    240 s on the same seed (common random numbers: the same turbulence at 240 s), or None."""
+    ref = {r["seed"]: r.get("dv_2sigma_range_kt") for r in ok_rows(rows)
+           if (r["design"], float(r["duration_s"])) == (REFERENCE[0], REFERENCE[1])}
+    logs = [np.log(r["dv_2sigma_range_kt"] / ref[r["seed"]]) for r in ok_rows(rows)
+            if (r["design"], float(r["duration_s"])) == (design, duration_s)
+            and ref.get(r["seed"]) and r.get("dv_2sigma_range_kt")]
+    return round(float(np.exp(np.mean(logs))), 3) if logs else None
+
+
+def _time_to(entries, target_kt):
+    """The flight time at which the design's predicted worst-row 2σ falls to `target_kt`
+    (log-log interpolation of the predicted curve), or None outside the times planned."""
+    pts = sorted((float(t), e["predicted_kt"]) for t, e in entries.items())
+    if target_kt is None or len(pts) < 2:
+        return None
+    t, v = np.log([p[0] for p in pts]), np.log([p[1] for p in pts])
+    if not v.min() <= np.log(target_kt) <= v.max():
+        return None
+    order = np.argsort(v)
+    return round(float(np.exp(np.interp(np.log(target_kt), v[order], t[order]))), 1)
+
+
+def headline(summary):
+    ref = summary["reference"].get("dv_2sigma_range_kt")
+    opt = summary["by_design"].get("optimal", {}).get("240", {}).get("dv_2sigma_range_kt")
+    if ref is None or opt is None:
+        return "no converged two-speed and optimal flights at 240 s"
+    gain = summary.get("optimal_gain_at_240s")
+    reach = summary.get("optimal_time_to_reference_s")
+    reach_text = f"{reach:.0f} s" if reach else "outside the times flown"
+    return (f"at 240 s optimal {opt:.2f} kt vs two-speed {ref:.2f} kt worst-row 2σ of ΔV over "
+            f"72-98 KIAS ({gain:+.0%} gain); two-speed's value reached in {reach_text}")
+
+
+def plot(rows, summary, out_dir):
+    return [save(figure(summary), out_dir, "design.png")]
+
+
+def figure(summary):
+    """Median worst-row 2σ of ΔV vs flight time (flown, with the median's standard error, and
+    predicted, with the ideal bound), and the coverage of ±2σ, per design."""
+    fig, ax = new_figure(1, 2, size=(5.0, 3.8))
+    for (design, entries), marker in zip(summary["by_design"].items(), "Dos"):
+        t = np.array(sorted(float(k) for k in entries))
+        e = [entries[str(int(x))] for x in t]
+        shift = {"optimal": -2.0, "optimal-2-level": 2.0}.get(design, 0.0)   # bars apart
+        bar = ax[0, 0].errorbar(t + shift, _nan([x["dv_2sigma_range_kt"] for x in e]),
+                                yerr=_nan([x.get("dv_2sigma_range_se_kt") for x in e]),
+                                fmt=marker + "-", capsize=2, label=f"{design} (flown)")
+        color = bar.lines[0].get_color()
+        ax[0, 0].plot(t, [x["predicted_kt"] for x in e], "x:" if t.size == 1 else ":",
+                      color=color, label=f"{design} (predicted)")
+        ax[0, 1].plot(t, 100 * _nan([x["coverage"] for x in e]), marker + "-", label=design,
+                      color=color)
+    bound = dict(sorted((float(k), v["ideal_bound_kt"]) for d in summary["by_design"].values()
+                        for k, v in d.items()))
+    if len(bound) > 1:
+        ax[0, 0].plot(list(bound), list(bound.values()), "k--", lw=0.8,
+                      label="ideal two-point bound")
+    ref = summary["reference"].get("dv_2sigma_range_kt")
+    if ref:
+        ax[0, 0].axhline(ref, color="0.6", lw=0.6, ls="-.", label="two-speed at 240 s")
+    ax[0, 0].set_ylabel("2σ of ΔV, kt (median,\nworst over 72-98 KIAS)")
+    ax[0, 1].set_ylabel("truth inside ±2σ, %")
+    ax[0, 1].axhspan(90, 98, color="0.9")
+    for a in ax.flat:
+        a.set_xlabel("flight time, s")
+        a.legend(fontsize=7)
+    fig.suptitle(f"Optimal design vs two-speed, {summary['turbulence_mps']:g} m/s turbulence")
+    return fig
+
+
+def _median(x):
+    x = x[np.isfinite(x)]
+    return float(np.median(x)) if x.size else None
+
+
+def _mean(x):
+    x = x[np.isfinite(x)]
+    return float(np.mean(x)) if x.size else None
+
+
+def _rms(x):
+    x = x[np.isfinite(x)]
+    return float(np.sqrt(np.mean(x ** 2))) if x.size else None
+
+
+def _nan(values):
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+
+STUDY = MonteCarloStudy(
+    "design", "information-optimal speed schedule vs two-speed: worst-row 2σ of ΔV, 72-98 KIAS",
+    task, cases, summarize, plot, headline, default_runs=20, quick_runs=1)
