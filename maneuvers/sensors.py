@@ -14,7 +14,8 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model, qci_from_qc_pa
 from pitotcal.core.scenario import true_k
 
-__all__ = ["first_order_lag", "gps_velocity_sensor", "hold_index", "impact_pressure_sensor"]
+__all__ = ["air_records", "first_order_lag", "gps_velocity_sensor", "hold_index",
+           "impact_pressure_sensor"]
 
 
 def first_order_lag(x, dt_s, tau_s):
@@ -143,3 +144,58 @@ def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, la
     # the result does not depend on how many updates there are before a given sample.
     noise = rng.standard_normal(vel.shape) * noise_mps
     return vel[held] + noise[held]
+
+
+def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
+    """The air-data truth and records of `AirSensors` (issue 9): (q_c, logged ρ, columns).
+
+    Parameters
+    ----------
+    time_s : ndarray (N,)
+    states : ndarray (N, 8)
+        The simulator's states (north, east, alt, heading, tas, bank, wind n, wind e).
+    air_data : {"incompressible", "compressible"}
+    sensors : maneuvers.sim_options.AirSensors
+    model, k :
+        The true pressure-error model: with compressible air data the static port reads
+        p_s + Δp_p, Δp_p = q_c − q_ci (all the error in the static source, as `simulate`).
+
+    Returns
+    -------
+    qc_pa : ndarray (N,)
+        True impact pressure at the probe: ½ ρ V_p² or isentropic at the virtual temperature,
+        V_p = V_t − r y the airspeed the probe sees (r = ψ̇ cos φ, y the arm).
+    rho_kgm3 : ndarray (N,)
+        The density a logger computes from what it logs, p_s / (R T_logged), dry air.
+    columns : dict
+        Flight fields: `ps_pa` (as the static port reads it), `oat_k` or `tat_k` (with bias),
+        `rh_pct` if humid.
+    """
+    from pitotcal.core.airdata import mach_from_tas, qc_from_tas_sq_pa
+    from pitotcal.core.moist_air import virtual_temperature_k
+    from pitotcal.core.units import R_AIR_JKGK, isa_pressure_pa, isa_temperature_k
+
+    _, _, alt, psi, tas, bank, _, _ = np.asarray(states, dtype=float).T
+    ps, ts = isa_pressure_pa(alt), isa_temperature_k(alt)
+    tv = virtual_temperature_k(ts, ps, sensors.rh_pct)
+    yaw_rate = (np.gradient(np.unwrap(psi), time_s) if psi.size > 1 else np.zeros_like(psi))
+    v_probe = tas - yaw_rate * np.cos(bank) * sensors.probe_arm_m
+    if air_data == "compressible":
+        qc = qc_from_tas_sq_pa(v_probe ** 2, ps, tv)
+    else:
+        qc = 0.5 * ps / (R_AIR_JKGK * tv) * v_probe ** 2
+    ps_read = ps
+    if air_data == "compressible":
+        m = get_model(model)
+        k = true_k(model) if k is None else k
+        ps_read = ps + qc - qci_from_qc_pa(m, tuple(k[:len(m.params)]), qc)
+    columns = {"ps_pa": ps_read}
+    if sensors.tat_recovery is None:
+        logged_t = columns["oat_k"] = ts + sensors.oat_bias_k
+    else:
+        mach = mach_from_tas(v_probe, ts)
+        logged_t = columns["tat_k"] = (ts * (1.0 + sensors.tat_recovery * 0.2 * mach ** 2)
+                                       + sensors.oat_bias_k)
+    if sensors.rh_pct > 0:
+        columns["rh_pct"] = np.full(alt.size, sensors.rh_pct)
+    return qc, ps_read / (R_AIR_JKGK * logged_t), columns

@@ -17,7 +17,7 @@ from pitotcal.core.models import get_model
 from pitotcal.core.plan import Plan
 from pitotcal.core.scenario import T2_PLAN, true_k
 
-__all__ = ["MAX_SAMPLES", "SimOptions", "check_plan", "sim_options"]
+__all__ = ["MAX_SAMPLES", "AirSensors", "SimOptions", "air_sensors", "check_plan", "sim_options"]
 
 # Memory grows with the samples (~1.5 kB each in the scalar loop, measured: 1.5 GB peak and
 # 13 s for 10^6): 500,000 is 2.8 h at 50 Hz, or 42 min at 200 Hz.
@@ -48,13 +48,73 @@ class SimOptions:
     gps_noise_mps: float
     gps_latency_s: float
     air_data: str = "incompressible"
+    air_sensors: "AirSensors | None" = None
 
     def to_dict(self):
-        """As written in the truth JSON (sequences as lists)."""
+        """As written in the truth JSON (sequences as lists; `air_sensors` only when set)."""
         out = asdict(self)
         out["k"], out["wind_drift_mps2"] = list(self.k), list(self.wind_drift_mps2)
+        if self.air_sensors is None:
+            del out["air_sensors"]                 # the default's truth JSON stays as it was
+        else:
+            out["air_sensors"]["gps_bias_mps"] = list(self.air_sensors.gps_bias_mps)
         return out
 
+
+@dataclass(frozen=True)
+class AirSensors:
+    """Air-data sensors and effects of the issue 9 budget (maneuvers.sensors.air_records).
+
+    Attributes
+    ----------
+    tat_recovery : float or None
+        A total-temperature probe with this recovery factor logs `tat_k` = T_s (1 + r 0.2 M²)
+        instead of a static `oat_k`; None: a static OAT sensor.
+    rh_pct : float
+        Relative humidity of the air mass, %: the true density and speed of sound use the
+        virtual temperature; logged as `rh_pct` when > 0.
+    probe_arm_m : float
+        Lateral position of the pitot probe, m (right wing +): in a turn at yaw rate r it sees
+        V_t − r y (ω × r), and q_c follows.
+    oat_bias_k : float
+        Bias of the logged temperature (static or total), K.
+    gps_bias_mps : (float, float, float)
+        Constant bias of the GPS velocity north, east, down, m/s.
+    """
+
+    tat_recovery: float | None = None
+    rh_pct: float = 0.0
+    probe_arm_m: float = 0.0
+    oat_bias_k: float = 0.0
+    gps_bias_mps: tuple = (0.0, 0.0, 0.0)
+
+
+def air_sensors(tat_recovery=None, rh_pct=0.0, probe_arm_m=0.0, oat_bias_k=0.0,
+                gps_bias_mps=(0.0, 0.0, 0.0)):
+    """Checked `AirSensors` (each value named like its parameter and flag)."""
+    if len(gps_bias_mps) != 3:
+        raise PitotcalError(f"gps_bias_mps must be (north, east, down), got {gps_bias_mps!r}",
+                            param="gps_bias_mps")
+    return AirSensors(
+        tat_recovery=(None if tat_recovery is None
+                      else number("tat_recovery", tat_recovery, 0.0, 1.0)),
+        rh_pct=number("rh_percent", rh_pct, 0.0, 100.0),
+        probe_arm_m=number("probe_arm_m", probe_arm_m, -50.0, 50.0),
+        oat_bias_k=number("oat_bias_k", oat_bias_k, -50.0, 50.0),
+        gps_bias_mps=tuple(number("gps_bias_mps", v, -10.0, 10.0) for v in gps_bias_mps))
+
+
+
+def _checked_air_sensors(value):
+    """None, an `AirSensors` (checked again), or a dict of `air_sensors` arguments."""
+    if value is None:
+        return None
+    if isinstance(value, AirSensors):
+        value = asdict(value)
+    if not isinstance(value, dict):
+        raise PitotcalError(f"air_sensors must be an AirSensors or a dict, got {value!r}",
+                            param="air_sensors")
+    return air_sensors(**value)
 
 
 def check_plan(plan):
@@ -88,7 +148,7 @@ def _true_k(model, k):
 def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, turbulence_mps,
              turbulence_length_m, rate_hz, qc_noise_pa, qc_quantization_pa, qc_bias_pa,
              qc_scale_error, pneumatic_lag_s, gps_rate_hz, gps_noise_mps, gps_latency_s,
-             air_data="incompressible"):
+             air_data="incompressible", sensors=None):
     """`SimOptions` from `simulate`'s arguments (see there): each checked, naming the parameter,
     the wind's defaults filled from the plan's settings, sizes checked against the plan."""
     settings = plan.settings or {}
@@ -118,7 +178,8 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
         gps_rate_hz=number("gps_rate_hz", gps_rate_hz or 0.0, 0.0),
         gps_noise_mps=number("gps_noise_mps", gps_noise_mps, 0.0),
         gps_latency_s=number("gps_latency_s", gps_latency_s, 0.0),
-        air_data=choice("air_data", air_data, AIR_DATA_MODES))
+        air_data=choice("air_data", air_data, AIR_DATA_MODES),
+        air_sensors=_checked_air_sensors(sensors))
     span_s = float(plan.time_s[-1] - plan.time_s[0])
     samples = span_s * opts.rate_hz + 1
     if samples > MAX_SAMPLES:

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from pitotcal.maneuvers.autopilot import GUIDANCE_GAINS, fly
 from pitotcal.maneuvers.autothrottle import tune_autothrottle
-from pitotcal.maneuvers.sensors import gps_velocity_sensor, impact_pressure_sensor
+from pitotcal.maneuvers.sensors import air_records, gps_velocity_sensor, impact_pressure_sensor
 from pitotcal.maneuvers.sim_options import MAX_SAMPLES, SimOptions, check_plan, sim_options
 from pitotcal.maneuvers.truth import (
     Tracking,
@@ -202,6 +202,10 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
         static = {"ps_pa": ps + dp, "oat_k": oat}
     else:
         qc = impact_pressure_pa(rho, tas ** 2)
+    air = {}
+    if opts.air_sensors is not None:      # issue 9 item 7: temperature, humidity, probe arm
+        qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
+                                   opts.k)
     climb = np.gradient(alt, dt) if n > 1 else np.zeros(n)
     vel = np.column_stack([tas * np.cos(psi) + wn, tas * np.sin(psi) + we, -climb])
     qci = impact_pressure_sensor(qc, dt, rng_qc, model=opts.model, k=opts.k,
@@ -211,6 +215,8 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
                                  quantization_pa=opts.qc_quantization_pa)
     gps = gps_velocity_sensor(t, vel, rng_gps, rate_hz=opts.gps_rate_hz,
                               noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s)
+    if opts.air_sensors is not None:
+        gps = gps + np.asarray(opts.air_sensors.gps_bias_mps)
     meta = {"generator": "pitotcal simulate", "seed": seed, "model": opts.model,
             **dict(zip(get_model(opts.model).params, opts.k)),
             "wind_speed_mps": opts.wind_speed_mps, "wind_from_deg": opts.wind_from_deg}
@@ -218,7 +224,7 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
         meta["air_data"] = opts.air_data
     flight = Flight(time_s=t, qci_pa=qci, gps_vn_mps=gps[:, 0], gps_ve_mps=gps[:, 1],
                     rho_kgm3=rho, gps_vd_mps=gps[:, 2], alt_m=alt,
-                    source=f"simulate(seed={seed})", meta=meta, **static)
+                    source=f"simulate(seed={seed})", meta=meta, **(air or static))
     return flight, qc, vel
 
 
@@ -271,7 +277,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
              rate_hz=50.0, qc_noise_pa=0.5, qc_quantization_pa=0.0, qc_bias_pa=0.0,
              qc_scale_error=0.0, pneumatic_lag_s=0.0, gps_rate_hz=5.0, gps_noise_mps=0.05,
              gps_latency_s=0.0, air_data="incompressible", limits=None, speed_loop=None,
-             keep_history=False):
+             keep_history=False, air_sensors=None):
     """Fly `plan` in simulation and record what the sensors would log.
 
     Parameters
@@ -317,6 +323,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     keep_history : bool
         Also return the true time histories as numpy arrays in truth.history (not written
         by `write_truth_json`).
+    air_sensors : maneuvers.sim_options.AirSensors or dict, optional (issue 9; None: as before)
 
     Returns
     -------
@@ -334,7 +341,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     opts = sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2,
                        turbulence_mps, turbulence_length_m, rate_hz, qc_noise_pa,
                        qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s,
-                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data)
+                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, air_sensors)
     seed = integer("seed", seed, 0)
     if limits is None:
         limits = Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",

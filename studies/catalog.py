@@ -15,6 +15,7 @@ from pitotcal.core.checks import choice, integer
 from pitotcal.core.errors import PitotcalError
 from pitotcal.io.jsonfile import write_json
 
+from .budget_study import STUDY as BUDGET
 from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
 from .legs_study import STUDY as LEGS
@@ -34,7 +35,7 @@ log = logging.getLogger(__name__)
 
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
-                               PEERS, LEGS, DESIGN, MONITOR)}
+                               PEERS, LEGS, DESIGN, MONITOR, BUDGET)}
 
 
 class StudyInterrupted(KeyboardInterrupt):

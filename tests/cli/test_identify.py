@@ -280,3 +280,40 @@ def test_auto_effective_n_is_n_over_the_bounds_variance_inflation(turbulence_mps
     assert n_eff == [pytest.approx(min(N, N * np.median(shrink)), rel=1e-9)] * 3
     assert low * N <= n_eff[0] <= high * N
     assert "variance inflation" in result.criterion
+
+
+# --- issue 9: temperature/humidity options and the uncertainty budget -----------------------
+
+def test_budget_in_summary_json_and_no_budget(flight_csv, tmp_path, capsys):
+    path, _ = flight_csv
+    out_json = tmp_path / "b.json"
+    assert main(["identify", str(path), "--json", str(out_json), "--probe-arm-m", "1.0",
+                 "--u-oat-k", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "Uncertainty budget (GUM; U = 2 u_c" in out and "probe_lever_arm" in out
+    d = json.loads(out_json.read_text())
+    budget = d["uncertainty_budget"]
+    assert budget[0]["source"] == "statistical"
+    assert [b["source"] for b in budget[1:]] == ["oat", "humidity", "gps_velocity_bias",
+                                                 "gps_latency", "probe_lever_arm", "qc_scale",
+                                                 "qc_offset"]
+    by = {b["source"]: b for b in budget}
+    assert by["oat"]["u_input"] == 2.0 and by["probe_lever_arm"]["u_dv_kt"] > 0.01
+    for row in d["airspeed_correction"]:
+        # U (k = 2) is at least the statistical 2σ and at most 2σ + 2 Σ u_j
+        assert row["dv_2sigma_kt"] <= row["dv_U_kt"]
+        assert row["dv_U_kt"] <= row["dv_2sigma_kt"] + 2 * sum(b["u_dv_kt"] for b in budget[1:])
+    assert main(["identify", str(path), "--json", str(out_json), "--no-budget"]) == 0
+    d = json.loads(out_json.read_text())
+    assert "uncertainty_budget" not in d and "dv_U_kt" not in d["airspeed_correction"][0]
+
+
+@pytest.mark.parametrize("argv, flag", [(["--u-oat-k", "-1"], "--u-oat-k"),
+                                        (["--temp-recovery", "1.5"], "--temp-recovery"),
+                                        (["--rh-percent", "120"], "--rh-percent"),
+                                        (["--u-rh-percent", "-3"], "--u-rh-percent")])
+def test_budget_and_air_options_refused(flight_csv, capsys, argv, flag):
+    path, _ = flight_csv
+    assert main(["identify", str(path), *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and flag in err

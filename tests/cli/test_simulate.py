@@ -134,3 +134,24 @@ def test_a_plan_beyond_what_plan_makes_is_refused_before_flying(tmp_path, plan_c
     assert err == (f"pitotcal simulate: {bad}: column alt_m, row 3 (line {header + 4}): 1e+06 "
                    "is outside -400 to 11000 m (what a plan can hold)")
     assert not (tmp_path / "f.csv").exists() and not (tmp_path / "f.truth.json").exists()
+
+
+# --- issue 9: the air-data sensor options ---------------------------------------------------
+
+def test_air_sensor_options(tmp_path, plan_csv, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["simulate", str(plan_csv), "-o", str(out), "--rate-hz", "5",
+                 "--tat-recovery", "0.98", "--rh-percent", "60", "--probe-arm-m", "1",
+                 "--oat-bias-k", "0.5", "--gps-bias-mps", "0.1", "0", "0"]) == 0
+    sensors = json.loads((tmp_path / "s.truth.json").read_text())["options"]["air_sensors"]
+    assert sensors == {"tat_recovery": 0.98, "rh_pct": 60.0, "probe_arm_m": 1.0,
+                       "oat_bias_k": 0.5, "gps_bias_mps": [0.1, 0.0, 0.0]}
+    flight = read_flight(out)
+    assert flight.tat_k is not None and flight.rh_pct[0] == 60.0
+    for argv, flag in ((["--rh-percent", "200"], "--rh-percent"),
+                       (["--tat-recovery", "-1"], "--tat-recovery"),
+                       (["--engine", "jsbsim", "--probe-arm-m", "1"], "--engine own only")):
+        capsys.readouterr()
+        assert main(["simulate", str(plan_csv), "-o", str(tmp_path / "x.csv"), *argv]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and flag in err

@@ -324,3 +324,29 @@ def test_bad_altitude_cells_keep_the_row(tmp_path):
         warnings.simplefilter("error")
         g = read_flight(empty)
     assert g.n == N and np.isnan(g.alt_m).all()
+
+
+# --- issue 9: total air temperature and humidity columns ------------------------------------
+
+def test_total_temperature_and_humidity_columns(tmp_path):
+    from pitotcal.core.airdata import mach_from_qc
+    from pitotcal.core.moist_air import moist_density_kgm3
+
+    cols = columns()
+    del cols["rho_kgm3"]
+    ps = np.full(N, 85000.0)
+    ts = np.full(N, 278.0)
+    tat = ts * (1 + 0.2 * mach_from_qc(cols["qc_pa"], ps) ** 2)
+    path = write(tmp_path / "tat.csv", {**cols, "ps_pa": ps, "tat_k": tat,
+                                        "rh_pct": np.full(N, 80.0)})
+    flight = read_flight(path)
+    # oat_k is the virtual temperature (humid): the density's and the speed of sound's
+    from pitotcal.core.moist_air import virtual_temperature_k
+    assert flight.oat_k == pytest.approx(virtual_temperature_k(ts, ps, 80.0), rel=1e-8)
+    assert flight.rho_kgm3 == pytest.approx(moist_density_kgm3(ps, ts, 80.0), rel=1e-8)
+    assert flight.meta["oat_k_source"].startswith("tat_k") and "oat_k_is" in flight.meta
+    # a file with ps_pa and oat_k keeps its density as before, and its channels
+    plain = write(tmp_path / "oat.csv", {**cols, "ps_pa": ps, "oat_k": ts})
+    flight = read_flight(plain)
+    assert flight.rho_kgm3 == pytest.approx(ps / (287.05287 * ts), rel=1e-8)
+    assert flight.tat_k is None and flight.oat_k == pytest.approx(ts)

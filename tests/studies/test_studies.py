@@ -39,6 +39,10 @@ LEAN = {  # name -> (runs, study columns, study summary keys, headline pattern)
     "wind": (1, {"profile", "wind_speed_mps", "wind_from_deg"}, {"by_profile"},
              (r"estimated vs flown wind within \d\.\d\d kt and \d+\.\d° RMS \(worst profile\), "
              r"truth inside 2σ in \S+ of the estimates \(paper: 0.5 kt, 4°\)")),
+    "budget": (1, {"turbulence_mps", "two_sigma_kt", "U_kt", "u_statistical_kt", "u_oat_kt",
+                   "u_probe_lever_arm_kt"}, {"by_turbulence_mps", "probe_arm_m"},
+               (r"turbulence 0 m/s: statistical 2σ \d\.\d\d kt, U \(k = 2\) \d\.\d\d kt "
+                r"\(\d+\.\dx\); largest Type B term \w+ u = \d\.\d\d kt")),
 }
 
 

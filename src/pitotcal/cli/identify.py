@@ -68,7 +68,58 @@ def add_parser(subparsers):
     live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
+    _add_budget_arguments(p)
     p.set_defaults(run=run)
+
+
+def _add_budget_arguments(p):
+    """Issue 9 items 4-5: temperature/humidity inputs and the uncertainty budget's overrides."""
+    air = p.add_argument_group("temperature and humidity")
+    air.add_argument("--temp-recovery", type=float, default=1.0, metavar="R",
+                     help="recovery factor of the total-temperature probe of a tat_k column, "
+                          "T_s = T_t / (1 + R 0.2 M^2); default %(default)s")
+    air.add_argument("--rh-percent", type=float, default=None, metavar="PCT",
+                     help="relative humidity, %%, for the density through the virtual "
+                          "temperature (overrides an rh_pct column; default: the column, else "
+                          "dry air)")
+    bud = p.add_argument_group(
+        "uncertainty budget",
+        "GUM budget of the airspeed correction: the statistical 2-sigma plus Type B inputs, "
+        "each given as a standard uncertainty and propagated by re-solving the perturbed "
+        "flight; reported as the expanded uncertainty U (k = 2)")
+    bud.add_argument("--no-budget", action="store_true",
+                     help="skip the budget (up to 14 extra solves)")
+    for flag, default, metavar, text in _BUDGET_FLAGS:
+        bud.add_argument(flag, type=float, default=default, metavar=metavar, help=text)
+
+
+# (flag, default, metavar, help); the defaults and their sources: estimation/budget.py
+_BUDGET_FLAGS = (
+    ("--u-oat-k", 1.0, "K", "static air temperature, K; default %(default)s"),
+    ("--u-rh-percent", None, "PCT", ("relative humidity, %%RH; default 5 with a humidity, "
+                                     "else 29 (dry assumed, 0-100 %% rectangular)")),
+    ("--u-gps-velocity-mps", 0.05, "MPS", "GPS velocity bias per axis, m/s; default %(default)s"),
+    ("--u-gps-latency-s", 0.05, "S", "GPS-pressure time alignment, s; default %(default)s"),
+    ("--probe-arm-m", 0.0, "M", ("lateral offset of the pitot probe from the centre line, m "
+                                 "(right wing +): turns make it see V_t - r y; default "
+                                 "%(default)s")),
+    ("--u-qc-scale-percent", 0.1, "PCT", "transducer gain, %% of reading; default %(default)s"),
+    ("--u-qc-offset-pa", 1.0, "PA", "transducer zero offset, Pa; default %(default)s"),
+)
+
+
+def _budget_inputs(args):
+    from pitotcal.core.checks import number
+    from pitotcal.estimation.budget import inputs_from_options
+
+    scale = number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0)
+    if args.u_rh_percent is not None:
+        number("u_rh_percent", args.u_rh_percent, 0.0, 100.0)
+    return inputs_from_options(
+        u_oat_k=args.u_oat_k, u_rh_pct=args.u_rh_percent,
+        u_gps_velocity_mps=args.u_gps_velocity_mps, u_gps_latency_s=args.u_gps_latency_s,
+        probe_arm_m=args.probe_arm_m, u_qc_scale=scale / 100.0,
+        u_qc_offset_pa=args.u_qc_offset_pa)
 
 
 def run(args):
@@ -79,7 +130,10 @@ def run(args):
     from pitotcal.cli.common import check_output, oat_k_from_c
     from pitotcal.core.checks import choice, number
     from pitotcal.core.models import MODELS
+    from pitotcal.core.moist_air import with_static_air
     from pitotcal.estimation import identify
+    from pitotcal.estimation.budget import uncertainty_budget
+    from pitotcal.estimation.budget_report import budget_summary, plot_budget_band
     from pitotcal.io import is_log_file, read_flight
 
     choice("model", args.model, [*MODELS, "auto"])
@@ -94,6 +148,11 @@ def run(args):
     if args.plot is not None:
         _check_plot_format(args.plot)
 
+    number("temp_recovery", args.temp_recovery, 0.0, 1.0)
+    if args.rh_percent is not None:
+        number("rh_percent", args.rh_percent, 0.0, 100.0)
+    inputs = None if args.no_budget else _budget_inputs(args)
+
     if args.params is None:
         flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
                              oat_k=oat_k_from_c(args.oat_c))
@@ -105,23 +164,32 @@ def run(args):
             from pitotcal.core.errors import PitotcalError
             raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
                                 "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
+    flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
     result = identify(flight, model=args.model, air=args.air,
                       gps_noise_std_mps=args.gps_noise_mps)
+    budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
           + (f", {flight.n_dropped} {cut}" if flight.n_dropped else "") + ")")
     print(result.summary())
+    if budget is not None:
+        print("\n" + budget_summary(result, budget))
     if not result.converged:
         warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "
                       "are not a calibration", stacklevel=2)
     if args.json is not None:
-        _write_json(args.json, result, flight, source)
+        _write_json(args.json, result, flight, source, budget)
         print(f"\nWrote {args.json}")
     if args.plot is not None:
         # matplotlib writes PNG and appends ".png" to a name without extension: say so
         plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-        result.plot(plot_path)
+        if budget is None:
+            result.plot(plot_path)
+        else:
+            fig = result.plot()
+            plot_budget_band(fig.axes[0], result, budget)      # the ΔV axes
+            fig.savefig(plot_path, dpi=110)
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
     if args.params is not None:
         _write_params(args, flight, autopilot, current)
@@ -144,11 +212,14 @@ def _write_params(args, flight, autopilot, current):
         print(f"  note: {note}")
 
 
-def _write_json(path, result, flight, source):
+def _write_json(path, result, flight, source, budget=None):
     """The result JSON, with every warning the reader gave in its "warnings"."""
-    from pitotcal.io.jsonfile import write_json
+    from pitotcal.estimation.budget_report import add_budget
+    from pitotcal.io.jsonfile import json_ready, write_json
 
     out = {**result.to_dict(), "source": str(source), "n_dropped": int(flight.n_dropped)}
+    if budget is not None:
+        out = json_ready(add_budget(out, budget))
     # `identify` may carry the reader's warnings already: add only those it does not have
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]

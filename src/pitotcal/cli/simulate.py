@@ -54,8 +54,45 @@ def add_parser(subparsers):
                         "time constant s, 0 frozen), static (SIZE s, 0 sealed), leak (SIZE "
                         "fraction low), icing (SIZE kt/min), water (SIZE fraction); the truth "
                         "JSON gets \"fault\"")
+    a = p.add_argument_group(
+        "air-data sensors (issue 9)",
+        "with any of these the flight also logs ps_pa, oat_k or tat_k, and rh_pct")
+    a.add_argument("--tat-recovery", type=float, default=None, metavar="R",
+                   help="log a total-temperature probe of recovery factor R (tat_k) instead of "
+                        "the static oat_k")
+    a.add_argument("--rh-percent", type=float, default=None, metavar="PCT",
+                   help="relative humidity of the air: the true density uses the virtual "
+                        "temperature; logged as rh_pct")
+    a.add_argument("--probe-arm-m", type=float, default=None, metavar="M",
+                   help="pitot probe at y = M on the wing (right +): it sees V_t - r y in turns")
+    a.add_argument("--oat-bias-k", type=float, default=None, metavar="K",
+                   help="bias of the logged temperature, K")
+    a.add_argument("--gps-bias-mps", type=float, nargs=3, default=None, metavar=("N", "E", "D"),
+                   help="constant GPS velocity bias north, east, down, m/s")
     p.set_defaults(run=run)
     return p
+
+
+def _air_sensor_option(args):
+    """{"air_sensors": ...} for `simulate` when any was given (own engine only), else {}."""
+    sensors = _air_sensors(args)
+    if sensors is None:
+        return {}
+    if args.engine != "own":
+        from pitotcal.core.errors import PitotcalError
+        raise PitotcalError("the air-data sensor options (--tat-recovery, --rh-percent, "
+                            "--probe-arm-m, --oat-bias-k, --gps-bias-mps) apply to --engine own "
+                            "only")
+    return {"air_sensors": sensors}
+
+
+def _air_sensors(args):
+    """The `air_sensors` dict of the options given, or None (then the files are as before)."""
+    given = {"tat_recovery": args.tat_recovery, "rh_pct": args.rh_percent,
+             "probe_arm_m": args.probe_arm_m, "oat_bias_k": args.oat_bias_k,
+             "gps_bias_mps": None if args.gps_bias_mps is None else tuple(args.gps_bias_mps)}
+    given = {k: v for k, v in given.items() if v is not None}
+    return given or None
 
 
 def _true_k(args):
@@ -143,7 +180,7 @@ def run(args):
         qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
         gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
-        keep_history=fault is not None)
+        keep_history=fault is not None, **_air_sensor_option(args))
     if fault is not None:
         from pitotcal.maneuvers.faults import apply_fault
         flight = apply_fault(flight, truth, fault)

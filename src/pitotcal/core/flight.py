@@ -43,6 +43,9 @@ class Flight:
     warnings : tuple of str
         Every warning the reader gave about this data (also issued with `warnings.warn`), so
         the result record can carry them.
+    tat_k, rh_pct : ndarray or None
+        Total air temperature (K) and relative humidity (%), when the data has them
+        (`pitotcal.core.moist_air.with_static_air` turns them into `oat_k` and `rho_kgm3`).
     """
 
     time_s: np.ndarray
@@ -59,6 +62,9 @@ class Flight:
     meta: dict = field(default_factory=dict)
     n_dropped: int = 0
     warnings: tuple = ()
+    # issue 9 (temperature and humidity): optional channels
+    tat_k: np.ndarray | None = None
+    rh_pct: np.ndarray | None = None
 
     @property
     def n(self):
@@ -78,4 +84,4 @@ class Flight:
 
 
 _ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m", "ps_pa",
-           "oat_k", "ps_ref_pa")
+           "oat_k", "ps_ref_pa", "tat_k", "rh_pct")

@@ -54,6 +54,7 @@ import numpy as np
 
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.flight import Flight
+from pitotcal.core.moist_air import with_static_air
 from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import density_kgm3
 
@@ -80,7 +81,7 @@ def write_flight_csv(flight, path, comments=None):
     """
     columns = ["time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3"]
     data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
-    for name in ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa"):
+    for name in ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa", *TEMPERATURE_COLUMNS):
         if getattr(flight, name) is not None:
             columns.append(name)
             data.append(getattr(flight, name))
@@ -98,6 +99,8 @@ OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_ref_pa")
 # Static pressure (the static source's reading) and temperature: density when rho_kgm3 is
 # absent, and the compressible calibration's air data whenever both are present.
 STATIC_COLUMNS = ("ps_pa", "oat_k")
+# issue 9 item 4: total air temperature and humidity, converted by core.moist_air
+TEMPERATURE_COLUMNS = ("tat_k", "rh_pct")
 MIN_ROWS = 10
 
 
@@ -142,16 +145,20 @@ def read_flight_csv(path, start_s=None, end_s=None):
         rho = data[:, col["rho_kgm3"]]
         check_rho(name, rho)
     else:
-        rho = density_kgm3(data[:, col["ps_pa"]], data[:, col["oat_k"]])
+        temperature = data[:, col["oat_k" if "oat_k" in col else "tat_k"]]
+        if "oat_k" not in col:              # total temperature: with_static_air converts it
+            check_ps_oat(name, data[:, col["ps_pa"]], temperature)
+        rho = density_kgm3(data[:, col["ps_pa"]], temperature)
     check_units(name, qci, vn, ve, rho)
     if "ps_ref_pa" in col:
         check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, 288.15), column="ps_ref_pa")
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
-                for c in (*OPTIONAL_COLUMNS, *STATIC_COLUMNS)}
-    return Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
-                  gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
-                  rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
-                  n_dropped=n_dropped, warnings=(warning,) if warning else (), **optional)
+                for c in (*OPTIONAL_COLUMNS, *STATIC_COLUMNS, *TEMPERATURE_COLUMNS)}
+    flight = Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
+                    gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
+                    rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
+                    n_dropped=n_dropped, warnings=(warning,) if warning else (), **optional)
+    return with_static_air(flight)          # issue 9: tat_k, rh_pct (core.moist_air)
 
 
 def csv_kind(path):
@@ -276,12 +283,16 @@ def _used_columns(name, columns):
         density = ["rho_kgm3"] + static
     elif static:
         density = static
+    elif "ps_pa" in present and "tat_k" in present:      # issue 9: total temperature
+        density = ["ps_pa", "tat_k"]
     else:
         found = [c for c in ("ps_pa", "oat_k") if c in present]
         also = f" (found only {found[0]})" if found else ""
         raise FlightDataError(f"{name}: missing column for density: needs rho_kgm3, or both "
                               f"ps_pa and oat_k{also}")
     use = list(REQUIRED_COLUMNS) + density + [c for c in OPTIONAL_COLUMNS if c in present]
+    if present & set(TEMPERATURE_COLUMNS):      # issue 9: and what converting them needs
+        use += [c for c in ("ps_pa", *TEMPERATURE_COLUMNS) if c in present and c not in use]
     for c in use:
         if columns.count(c) > 1:
             raise FlightDataError(f"{name}: column {c} appears {columns.count(c)} times in the "

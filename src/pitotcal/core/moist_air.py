@@ -1,0 +1,180 @@
+"""Temperature and humidity inputs of the air data: total to static temperature, moist air.
+
+    T_s  = T_t / (1 + r 0.2 M²),   M from q_ci / p_s            (static from total temperature)
+    e_s  = 610.94 exp(17.625 t / (t + 243.04)) Pa, t in °C      (saturation over water)
+    e    = (RH / 100) e_s(T_s)
+    T_v  = T_s / (1 − (e / p_s)(1 − ε)),   ε = R_d / R_v = 0.622 (virtual temperature)
+    ρ    = p_s / (R_d T_v),   a = sqrt(γ R_d T_v)
+
+r is the probe's recovery factor (1 for an ideal total-temperature probe: it reads the
+stagnation temperature; 0.95-1 for real probes, from the probe's data sheet). The saturation
+law is the Magnus form of Alduchov and Eskridge (1996), "Improved Magnus form approximation of
+saturation vapor pressure", J. Appl. Meteor. 35, 601-609, eq. 21: within 0.4 % of the
+Wexler/Hyland-Wexler tables from −40 to +50 °C (the tests compare it with ASHRAE's formula
+through psychrolib and with table values). Water vapour (ε = 0.622) makes air lighter at the
+same pressure and temperature: humid air is 0.3-1.6 % less dense than dry at 15-30 °C, 100 %
+RH. γ is taken as 1.4 for moist air too (the change is below 0.1 %).
+
+`with_static_air` turns a `Flight` with these columns into the Flight the estimator needs:
+`oat_k` the static temperature (virtual when humid: the compressible relations take it for
+both the density and the speed of sound) and `rho_kgm3` = p_s / (R T_v).
+"""
+
+import dataclasses
+import warnings
+
+import numpy as np
+
+from pitotcal.core.airdata import mach_from_qc
+from pitotcal.core.checks import number
+from pitotcal.core.errors import FlightDataError
+from pitotcal.core.units import R_AIR_JKGK
+
+__all__ = [
+    "EPSILON",
+    "moist_density_kgm3",
+    "saturation_vapour_pressure_pa",
+    "static_temperature_k",
+    "virtual_temperature_k",
+    "with_static_air",
+]
+
+EPSILON = 0.622                       # R_d / R_v, molar mass of water over that of dry air
+_C_TO_K = 273.15
+_OAT_SOURCE = "oat_k_source"          # Flight.meta key: how oat_k was obtained
+_OAT_VIRTUAL = "oat_k_is"             # Flight.meta key: present when oat_k is virtual
+# Alduchov & Eskridge (1996) eq. 21, over water
+_AE_A_PA, _AE_B, _AE_C_C = 610.94, 17.625, 243.04
+
+
+def saturation_vapour_pressure_pa(t_k):
+    """Saturation vapour pressure over water, Pa, at temperature `t_k` (K); Magnus-AE 1996.
+
+    Example
+    -------
+    >>> round(float(saturation_vapour_pressure_pa(293.15)))        # table: 2339 Pa at 20 °C
+    2333
+    """
+    t_c = np.asarray(t_k, dtype=float) - _C_TO_K
+    return _AE_A_PA * np.exp(_AE_B * t_c / (t_c + _AE_C_C))
+
+
+def virtual_temperature_k(t_k, ps_pa, rh_pct):
+    """Virtual temperature T_v = T / (1 − (e/p)(1 − ε)), K: the dry-air temperature of equal density.
+
+    Parameters
+    ----------
+    t_k : array_like
+        Static air temperature, K.
+    ps_pa : array_like
+        Static pressure, Pa.
+    rh_pct : array_like
+        Relative humidity over water, percent (0-100).
+    """
+    e_pa = np.asarray(rh_pct, dtype=float) / 100.0 * saturation_vapour_pressure_pa(t_k)
+    return np.asarray(t_k, dtype=float) / (1.0 - e_pa / np.asarray(ps_pa, dtype=float)
+                                           * (1.0 - EPSILON))
+
+
+def moist_density_kgm3(ps_pa, t_k, rh_pct=0.0):
+    """Density of moist air, ρ = p_s / (R_d T_v), kg/m³."""
+    return np.asarray(ps_pa, dtype=float) / (R_AIR_JKGK * virtual_temperature_k(t_k, ps_pa,
+                                                                                rh_pct))
+
+
+def static_temperature_k(tat_k, qci_pa, ps_pa, recovery=1.0):
+    """Static air temperature T_s = T_t / (1 + r 0.2 M²), K, from a total-temperature probe.
+
+    Parameters
+    ----------
+    tat_k : array_like
+        Total (probe) air temperature, K.
+    qci_pa, ps_pa : array_like
+        Impact and static pressure, Pa: the Mach number is M = sqrt(5[(q_c/p_s + 1)^(2/7) − 1]).
+    recovery : float
+        The probe's recovery factor r, 0-1 (1: an ideal stagnation probe).
+    """
+    mach = mach_from_qc(qci_pa, ps_pa)
+    return np.asarray(tat_k, dtype=float) / (1.0 + recovery * 0.2 * mach ** 2)
+
+
+def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
+    """The Flight the estimator needs: static `oat_k` and a density through the virtual temperature.
+
+    Parameters
+    ----------
+    flight : pitotcal.core.flight.Flight
+        With `ps_pa`, and `oat_k` (static) or `tat_k` (total); `rh_pct` optional.
+    temp_recovery : float
+        Recovery factor of the total-temperature probe (`--temp-recovery`), used when the
+        flight has `tat_k` and no `oat_k`.
+    rh_pct : float, optional
+        Relative humidity, percent (`--rh-percent`); overrides the flight's `rh_pct` column.
+
+    Returns
+    -------
+    Flight
+        `flight` itself when it has neither `tat_k` nor humidity; else a copy with `oat_k`
+        the static temperature — the virtual temperature T_v when a humidity is known
+        (`meta["oat_k_is"]` says so), as the compressible relations and the density both
+        need it — `rho_kgm3` = p_s / (R T_v), and the humidity used in `rh_pct`. An `oat_k`
+        converted from `tat_k` is marked in `meta["oat_k_source"]`; a second call (the
+        reader calls it with r = 1 and the file's humidity, `identify --temp-recovery` and
+        `--rh-percent` again) converts from the raw inputs again.
+
+    Raises
+    ------
+    PitotcalError
+        `temp_recovery` outside [0, 1], `rh_pct` outside [0, 100].
+    FlightDataError
+        `rh_pct` given for a flight without the static pressure. (Columns `tat_k` or `rh_pct`
+        without `ps_pa` are ignored with a warning, also in `Flight.warnings`: the density is
+        then the file's `rho_kgm3`.)
+    """
+    temp_recovery = number("temp_recovery", temp_recovery, 0.0, 1.0)
+    if rh_pct is not None:
+        rh_pct = number("rh_percent", rh_pct, 0.0, 100.0)
+    tat, oat = flight.tat_k, flight.oat_k
+    if tat is not None and flight.meta.get(_OAT_SOURCE, "").startswith("tat_k"):
+        oat = None                    # converted before (by the reader): again, with this r
+    elif oat is not None and _OAT_VIRTUAL in flight.meta and flight.rh_pct is not None:
+        oat = _dry_from_virtual_k(oat, flight.ps_pa, flight.rh_pct)    # humidity applied before
+    rh = flight.rh_pct if rh_pct is None else np.full(flight.n, rh_pct)
+    if tat is None and rh is None:
+        return flight
+    ps = flight.ps_pa
+    if ps is None:
+        what = "tat_k" if tat is not None and oat is None else "the humidity"
+        message = (f"{flight.source}: {what} needs the static pressure (column ps_pa) to "
+                   "convert it")
+        if rh_pct is not None:            # asked for explicitly: cannot be honoured
+            raise FlightDataError(message, param="rh_percent")
+        message += "; ignored, the density is the file's rho_kgm3"
+        warnings.warn(message, stacklevel=2)
+        return dataclasses.replace(flight, warnings=(*flight.warnings, message))
+    meta = {k: v for k, v in flight.meta.items() if k != _OAT_VIRTUAL}
+    if oat is None:
+        oat = static_temperature_k(tat, flight.qci_pa, ps, temp_recovery)
+        meta[_OAT_SOURCE] = f"tat_k, recovery factor {temp_recovery:g}"
+    if rh is not None and np.any((rh < 0) | (rh > 100)):
+        bad = int(np.argmax((rh < 0) | (rh > 100)))
+        raise FlightDataError(f"{flight.source}: column rh_pct, row {bad + 1}: {rh[bad]:g} is "
+                              "outside 0-100 %")
+    t_air = np.asarray(oat, dtype=float)
+    if rh is not None:
+        # the air-data relations take the virtual temperature: the dry-air temperature of
+        # the same density (ρ = p/(R T_v)) and, within 0.1 %, speed of sound (a² = γ R T_v)
+        t_air = virtual_temperature_k(t_air, ps, rh)
+        meta[_OAT_VIRTUAL] = "virtual temperature (rh_pct applied)"
+    return dataclasses.replace(flight, oat_k=t_air, rho_kgm3=ps / (R_AIR_JKGK * t_air),
+                               rh_pct=rh, meta=meta)
+
+
+def _dry_from_virtual_k(tv_k, ps_pa, rh_pct):
+    """T from T_v = T / (1 − (e(T)/p)(1 − ε)): a fixed point contracting by ≤ 0.3 a step."""
+    t = np.asarray(tv_k, dtype=float)
+    for _ in range(30):
+        e_pa = np.asarray(rh_pct, float) / 100.0 * saturation_vapour_pressure_pa(t)
+        t = tv_k * (1.0 - e_pa / ps_pa * (1.0 - EPSILON))
+    return t
+
