@@ -3,8 +3,8 @@
 A leg is a stretch of steady flight: ground track, ground speed and indicated airspeed each
 inside a band of ± tolerance about their values over the stretch, for at least a minimum time.
 `detect_segments` finds them on 1 s means smoothed over `smooth_s` (gusts and GPS noise would
-otherwise break every band), greedily from the earliest start, and trims `smooth_s / 2` from
-each end (the smoothing carries the turn into the leg's edges). `legs_from_flight` turns each
+otherwise break every band), greedily from the earliest start, and trims `smooth_s / 2 + 1 s`
+from each end (the smoothing and the 1 s bins carry the turn into the leg's edges). `legs_from_flight` turns each
 segment into one row of the leg CSV (`pitotcal.io.legs_csv.LegData`):
 
 - ground speed and track from the mean ground velocity vector over the segment;
@@ -98,7 +98,7 @@ def detect_segments(flight, min_leg_s=30.0, track_tol_deg=3.0, groundspeed_tol_k
     gs = np.hypot(vn, ve) / KT_TO_MPS
     track = np.degrees(np.arctan2(ve, vn))
     ok = np.isfinite(gs) & np.isfinite(ias) & (ias >= MIN_IAS_KT)
-    trim = 0.5 * smooth_s
+    trim = 0.5 * smooth_s + 1.0        # the smoothing's reach, and the 1 s bins'
     need = min_leg_s + 2.0 * trim
     out, i = [], 0
     while i < t0.size:

@@ -17,6 +17,7 @@ from pitotcal.io.jsonfile import write_json
 
 from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
+from .legs_flight_study import STUDY as LEGS_FLIGHT
 from .legs_study import STUDY as LEGS
 from .maneuvers_study import STUDY as MANEUVERS
 from .real_alfa import STUDY as REAL_ALFA
@@ -32,7 +33,7 @@ log = logging.getLogger(__name__)
 
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
-                               PEERS, LEGS)}
+                               PEERS, LEGS, LEGS_FLIGHT)}
 
 
 class StudyInterrupted(KeyboardInterrupt):
