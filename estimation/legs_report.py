@@ -132,9 +132,10 @@ def plot_legs(points, fit, path, series=None):
         lo, hi = fit.vi_range_kt
         vi = np.linspace(lo, hi, 200)
         dv, half = fit.delta_v_kt(vi)
+        name = "global fit" if series is None else "global fit over the legs"
         ax.fill_between(vi, dv - half, dv + half, color="C0", alpha=0.25,
-                        label=f"global fit ({fit.model}) ±2σ" if fit.noise_source == "stated"
-                        else f"global fit ({fit.model}), 95 % band")
+                        label=f"{name} ({fit.model}) ±2σ" if fit.noise_source == "stated"
+                        else f"{name} ({fit.model}), 95 % band")
         ax.plot(vi, dv, color="C0", lw=2)
     if series is not None:
         vi = np.linspace(min(s.ias_kt for s in points), max(s.ias_kt for s in points), 200)
