@@ -255,6 +255,31 @@ def _group(ias, alt_m, tol_kt):
     return tuple(labels)
 
 
+def _drop_short_points(legs, spans):
+    """Detected points with fewer than three legs (a straight climb, a lone cruise leg) left
+    out, each with a note; (legs, spans, notes)."""
+    from dataclasses import replace
+
+    keep, notes = [], []
+    for label in legs.points():
+        idx = legs.indices(label)
+        if idx.size >= 3:
+            keep += list(idx)
+            continue
+        when = ", ".join(f"{spans[i, 0]:.0f}-{spans[i, 1]:.0f} s" for i in idx)
+        notes.append(f"detected point {label} ({legs.ias_kt[idx[0]]:.0f} KIAS) has "
+                     f"{idx.size} leg{'s' * (idx.size > 1)} ({when}): left out, three are needed")
+    if not keep:
+        raise FlightDataError(f"{legs.source}: no indicated airspeed was flown on three or more "
+                              f"steady legs; {'; '.join(notes)}")
+    keep = np.sort(keep)
+    arrays = ("ias_kt", "qci_pa", "pressure_alt_m", "oat_k", "groundspeed_mps", "track_deg",
+              "duration_s", "groundspeed_sd_mps")
+    legs = replace(legs, point=tuple(legs.point[i] for i in keep),
+                   **{a: getattr(legs, a)[keep] for a in arrays})
+    return legs, spans[keep], notes
+
+
 def leg_samples(flight, spans):
     """The flight restricted to the samples inside the legs' (start_s, end_s) spans."""
     mask = np.zeros(flight.n, dtype=bool)
@@ -299,8 +324,18 @@ def analyze_leg_flight(flight, windows=None, model="inverse", wind="per-band",
         detection = options
     else:
         detection = "windows"
+    if not len(windows):
+        raise FlightDataError(
+            f"{flight.source}: no steady segment of {options['min_leg_s']:g} s or more (track "
+            f"±{options['track_tol_deg']:g}°, ground speed ±{options['groundspeed_tol_kt']:g} "
+            f"kt, IAS ±{options['ias_tol_kt']:g} kt): give the legs' time windows, or widen "
+            f"the tolerances")
     legs, spans = legs_from_flight(flight, windows, point_tol_kt=point_tol_kt)
+    dropped = []
+    if detection != "windows":
+        legs, spans, dropped = _drop_short_points(legs, spans)
     points, fit, notes = analyze_legs(legs, model=model, wind=wind)
+    notes[:0] = dropped
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

@@ -113,3 +113,18 @@ def test_flight_without_static_pressure_refused(flown):
 def test_window_without_samples_refused(flown):
     with pytest.raises(FlightDataError, match="window 5000-5060 s holds 0 samples"):
         legs_from_flight(flown[0], [(5000.0, 5060.0, None)])
+
+
+def test_detected_point_with_too_few_legs_left_out(flown):
+    """A lone steady leg at another speed (here: the 160 KIAS point cut to two legs) is left
+    out with a note instead of refusing the flight."""
+    flight, _, windows = flown
+    res = analyze_leg_flight(flight.window(None, windows[13][1] + 10.0))
+    assert [s.point for s in res["points"]] == ["1", "2", "3"]
+    assert res["notes"][0].startswith("detected point 4 (160 KIAS) has 2 legs (")
+    assert len(res["spans"]) == 12
+
+
+def test_no_steady_segment_says_what_to_do(flown):
+    with pytest.raises(FlightDataError, match=r"no steady segment of 500 s or more \(track ±3°"):
+        analyze_leg_flight(flown[0], min_leg_s=500.0)
