@@ -66,6 +66,8 @@ def test_windows_text_and_csv(flight_csv, tmp_path, capsys):
 @pytest.mark.parametrize("extra, match", [
     (["--windows", "100-50"], "--windows: window 100-50: the end must come after the start"),
     (["--min-leg-s", "-5"], "--min-leg-s -5 must be > 0"),
+    (["--windows", "missing.csv"], "--windows missing.csv: no such file"),
+    (["--min-leg-s", "900"], "no steady segment of 900 s or more"),
 ])
 def test_bad_options_one_line(flight_csv, extra, match, capsys):
     assert main(["legs", str(flight_csv[0]), *extra]) == 2

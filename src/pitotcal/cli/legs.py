@@ -121,11 +121,16 @@ def _run_legs(args, source):
 
 
 def _windows(text):
+    from pitotcal.core.errors import PitotcalError
     from pitotcal.estimation.legs_flight import parse_windows, read_windows
 
     if text is None:
         return None
-    return read_windows(text) if Path(text).is_file() else parse_windows(text)
+    if Path(text).is_file():
+        return read_windows(text)
+    if text.lower().endswith(".csv"):
+        raise PitotcalError(f"--windows {text}: no such file", param="windows")
+    return parse_windows(text)
 
 
 def _run_flight(args, source):
