@@ -91,3 +91,18 @@ def test_flight_without_static_pressure_exit_2(tmp_path, capsys):
     write_flight_csv(replace(flight, ps_pa=None, oat_k=None), path)
     assert main(["legs", str(path)]) == 2
     assert "no ps_pa: the leg methods need" in capsys.readouterr().err
+
+
+def test_ulog_legs_detected(tmp_path, capsys):
+    """A PX4 log goes through read_flight: the legs are found in it (the test log's static
+    pressure is a constant 97 kPa, so only the detection is checked here)."""
+    from logwriters import write_ulog
+
+    flight, _, windows = simulate_leg_flight(ias_kt=(80, 120), rate_hz=5.0, seed=2)
+    path = tmp_path / "legs.ulg"
+    write_ulog(path, flight)
+    out_json = tmp_path / "r.json"
+    assert main(["legs", str(path), "--json", str(out_json)]) == 0
+    d = json.loads(out_json.read_text())
+    assert [s["point"] for s in d["segments"]] == [w[2] for w in windows]
+    capsys.readouterr()
