@@ -335,14 +335,16 @@ def analyze_leg_flight(flight, windows=None, model="inverse", wind="per-band",
     if detection != "windows":
         legs, spans, dropped = _drop_short_points(legs, spans)
     points, fit, notes = analyze_legs(legs, model=model, wind=wind)
-    notes[:0] = dropped
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             series = identify(leg_samples(flight, spans), model, air="compressible")
-        notes += [f"time-series fit: {w}" for w in series.warnings]
+        extra = [f"time-series fit: {w}" for w in series.warnings]
     except (ObservabilityError, FlightDataError) as exc:
         series = None
-        notes.append(f"no time-series fit: {exc}")
+        extra = [f"no time-series fit: {exc}"]
+    for note in dropped + extra:
+        warnings.warn(note, stacklevel=2)
+    notes = dropped + notes + extra
     return {"legs": legs, "spans": spans, "points": points, "fit": fit, "series": series,
             "notes": notes, "detection": detection}

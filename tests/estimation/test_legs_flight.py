@@ -77,7 +77,8 @@ def test_north_east_south_legs_solved_without_a_time_series_fit():
     refuses it and the result says why."""
     flight, _, _ = simulate_leg_flight(ias_kt=(80, 140), headings_deg=(0, 90, 180),
                                        rate_hz=2.0, seed=5)
-    res = analyze_leg_flight(flight)
+    with pytest.warns(UserWarning, match="no time-series fit"):
+        res = analyze_leg_flight(flight)
     assert [s.method for s in res["points"]] == ["3-leg", "3-leg"]
     assert res["series"] is None
     assert any(n.startswith("no time-series fit:") and "180" in n for n in res["notes"])
@@ -119,7 +120,8 @@ def test_detected_point_with_too_few_legs_left_out(flown):
     """A lone steady leg at another speed (here: the 160 KIAS point cut to two legs) is left
     out with a note instead of refusing the flight."""
     flight, _, windows = flown
-    res = analyze_leg_flight(flight.window(None, windows[13][1] + 10.0))
+    with pytest.warns(UserWarning, match="detected point 4 .160 KIAS. has 2 legs"):
+        res = analyze_leg_flight(flight.window(None, windows[13][1] + 10.0))
     assert [s.point for s in res["points"]] == ["1", "2", "3"]
     assert res["notes"][0].startswith("detected point 4 (160 KIAS) has 2 legs (")
     assert len(res["spans"]) == 12
