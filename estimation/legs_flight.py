@@ -34,8 +34,8 @@ from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
 from pitotcal.io.legs_csv import LegData
 
-__all__ = ["DETECT_DEFAULTS", "POINT_ALT_TOL_FT", "detect_segments",
-           "leg_samples", "legs_from_flight", "parse_windows", "read_windows"]
+__all__ = ["DETECT_DEFAULTS", "POINT_ALT_TOL_FT", "analyze_leg_flight", "detect_segments",
+           "leg_samples", "legs_from_flight", "parse_windows", "pool_sd", "read_windows"]
 
 DETECT_DEFAULTS = {"min_leg_s": 30.0, "track_tol_deg": 3.0, "groundspeed_tol_kt": 3.0,
                    "ias_tol_kt": 2.0, "smooth_s": 5.0}
@@ -60,7 +60,9 @@ def _second_means(flight):
     with np.errstate(invalid="ignore"):
         means = [np.bincount(b, weights=x) / count
                  for x in (flight.gps_vn_mps, flight.gps_ve_mps, flight.qci_pa)]
-    ias = airdata.cas_from_qc_mps(np.clip(means[2], 0.0, None)) / KT_TO_MPS
+    ias = np.full(count.size, np.nan)
+    seen = count > 0                       # a gap in the record leaves empty bins
+    ias[seen] = airdata.cas_from_qc_mps(np.clip(means[2][seen], 0.0, None)) / KT_TO_MPS
     return t[0] + np.arange(count.size), means[0], means[1], ias
 
 
@@ -192,7 +194,7 @@ def _mean_velocity_sd(vn, ve):
     return float(np.sqrt(np.mean(var)))
 
 
-def legs_from_flight(flight, windows, point_tol_kt=POINT_TOL_KT):
+def legs_from_flight(flight, windows, point_tol_kt=POINT_TOL_KT, pool=True):
     """One leg per window (module docstring).
 
     Parameters
@@ -202,6 +204,8 @@ def legs_from_flight(flight, windows, point_tol_kt=POINT_TOL_KT):
     windows : sequence of (start_s, end_s, point or None)
         Point labels given for every window are used; otherwise points are grouped by IAS.
     point_tol_kt : float
+    pool : bool
+        Give every leg the pooled groundspeed_sd (`pool_sd`); else each leg its own.
 
     Returns
     -------
@@ -228,16 +232,24 @@ def legs_from_flight(flight, windows, point_tol_kt=POINT_TOL_KT):
     given = [row[7] for row in rows]
     labels = (tuple(str(p) for p in given) if all(p is not None for p in given)
               else _group(ias, alt_m, point_tol_kt))
-    # one pooled sd: each leg's own rests on a few correlation times, and weighting legs by such
-    # noisy estimates made the global fit's bounds too small (study legs-flight: 85 % coverage
-    # with per-leg weights, 94.5 % pooled)
-    pooled = float(np.sqrt(np.mean(r[:, 2] ** 2)))
     legs = LegData(point=labels, ias_kt=ias, qci_pa=r[:, 3], pressure_alt_m=alt_m,
                    oat_k=r[:, 5], groundspeed_mps=np.hypot(r[:, 0], r[:, 1]),
                    track_deg=np.degrees(np.arctan2(r[:, 1], r[:, 0])) % 360.0,
-                   duration_s=r[:, 6], groundspeed_sd_mps=np.full(len(r), pooled),
-                   source=flight.source)
-    return legs, np.array([row[8:10] for row in rows], dtype=float)
+                   duration_s=r[:, 6], groundspeed_sd_mps=r[:, 2], source=flight.source)
+    return pool_sd(legs) if pool else legs, np.array([row[8:10] for row in rows], dtype=float)
+
+
+def pool_sd(legs):
+    """`legs` with every groundspeed_sd replaced by their root mean square.
+
+    Each leg's own value rests on a few correlation times of gusts; weighting the legs by such
+    noisy estimates made the global fit's bounds too small (study legs-flight, 100 runs: 85 %
+    coverage with each leg's own, 94.5 % pooled).
+    """
+    from dataclasses import replace
+
+    pooled = float(np.sqrt(np.mean(legs.groundspeed_sd_mps ** 2)))
+    return replace(legs, groundspeed_sd_mps=np.full(legs.n, pooled))
 
 
 def _group(ias, alt_m, tol_kt):
@@ -307,7 +319,8 @@ def analyze_leg_flight(flight, windows=None, model="inverse", wind="per-band",
     dict
         legs (LegData), spans (n, 2), points, fit (LegFit or None), series
         (IdentificationResult or None: `identify` on the legs' samples, one wind, colored-
-        residual bounds), notes (list of str), detection (the options used, or "windows").
+        residual bounds), notes (list of str), detection (the options used, or "windows"),
+        leg_sd_own_mps (each leg's own sd of the mean velocity; `legs` carries the pooled one).
     """
     import warnings
 
@@ -330,10 +343,12 @@ def analyze_leg_flight(flight, windows=None, model="inverse", wind="per-band",
             f"±{options['track_tol_deg']:g}°, ground speed ±{options['groundspeed_tol_kt']:g} "
             f"kt, IAS ±{options['ias_tol_kt']:g} kt): give the legs' time windows, or widen "
             f"the tolerances")
-    legs, spans = legs_from_flight(flight, windows, point_tol_kt=point_tol_kt)
+    legs, spans = legs_from_flight(flight, windows, point_tol_kt=point_tol_kt, pool=False)
     dropped = []
     if detection != "windows":
         legs, spans, dropped = _drop_short_points(legs, spans)
+    own_sd = legs.groundspeed_sd_mps
+    legs = pool_sd(legs)
     points, fit, notes = analyze_legs(legs, model=model, wind=wind)
     try:
         with warnings.catch_warnings():
@@ -346,5 +361,11 @@ def analyze_leg_flight(flight, windows=None, model="inverse", wind="per-band",
     for note in dropped + extra:
         warnings.warn(note, stacklevel=2)
     notes = dropped + notes + extra
+    if fit is not None and len(fit.group_labels) > 1 and series is not None:
+        extra.append(f"the time-series fit has one wind for the record, but the legs span "
+                     f"{len(fit.group_labels)} altitude bands ({', '.join(fit.group_labels)}): "
+                     f"compare it with the leg-level fit, which has a wind per band")
+        warnings.warn(extra[-1], stacklevel=2)
+        notes.append(extra[-1])
     return {"legs": legs, "spans": spans, "points": points, "fit": fit, "series": series,
-            "notes": notes, "detection": detection}
+            "notes": notes, "detection": detection, "leg_sd_own_mps": own_sd}

@@ -166,8 +166,8 @@ def _series_dict(res):
 
 def flight_legs_json(res, source):
     """The JSON of `pitotcal legs FLIGHT`: that of a leg file plus input "flight", detection,
-    segments [{leg, point, start_s, end_s, groundspeed_kt, track_deg, groundspeed_sd_kt,
-    ias_kt}] and global_timeseries (the identify JSON of the legs' samples, or null)."""
+    segments [{leg, point, start_s, end_s, groundspeed_kt, track_deg, groundspeed_sd_kt
+    (pooled, as used), groundspeed_sd_own_kt, ias_kt}] and global_timeseries (the identify JSON of the legs' samples, or null)."""
     from pitotcal.io.jsonfile import json_ready
 
     legs = res["legs"]
@@ -177,6 +177,7 @@ def flight_legs_json(res, source):
                  "groundspeed_kt": legs.groundspeed_mps[i] / KT_TO_MPS,
                  "track_deg": legs.track_deg[i],
                  "groundspeed_sd_kt": legs.groundspeed_sd_mps[i] / KT_TO_MPS,
+                 "groundspeed_sd_own_kt": res["leg_sd_own_mps"][i] / KT_TO_MPS,
                  "ias_kt": legs.ias_kt[i]} for i, (lo, hi) in enumerate(res["spans"])]
     out.update({"input": "flight", "detection": res["detection"], "segments": segments,
                 "global_timeseries": _series_dict(res)})
@@ -188,13 +189,14 @@ def flight_legs_text(res):
     legs = res["legs"]
     how = ("given windows" if res["detection"] == "windows" else
            "detected: " + ", ".join(f"{k} {v:g}" for k, v in res["detection"].items()))
+    pooled = legs.groundspeed_sd_mps[0] / KT_TO_MPS
     lines = [f"Legs from the time series ({how}):",
              (f"  {'leg':>4}{'point':>7}{'start s':>10}{'end s':>9}{'KIAS':>7}{'GS kt':>8}"
-              f"{'track':>7}{'sd kt':>7}")]
+              f"{'track':>7}{'sd kt':>7}   (sd: the leg's own; pooled {pooled:.2f} kt used)")]
     for i, (lo, hi) in enumerate(res["spans"]):
         lines.append(f"  {i + 1:4d}{legs.point[i]:>7}{lo:10.1f}{hi:9.1f}{legs.ias_kt[i]:7.1f}"
                      f"{legs.groundspeed_mps[i] / KT_TO_MPS:8.2f}{legs.track_deg[i]:7.1f}"
-                     f"{legs.groundspeed_sd_mps[i] / KT_TO_MPS:7.2f}")
+                     f"{res['leg_sd_own_mps'][i] / KT_TO_MPS:7.2f}")
     series, fit = res["series"], res["fit"]
     if series is None:
         return "\n".join(lines)

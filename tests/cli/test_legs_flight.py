@@ -32,6 +32,8 @@ def test_detected_legs_json_and_legs_out(flight_csv, tmp_path, capsys):
     assert "Global fit over the legs' time series (identify" in out
     d = json.loads(out_json.read_text())
     assert d["input"] == "flight" and len(d["segments"]) == 16
+    assert len({s["groundspeed_sd_kt"] for s in d["segments"]}) == 1      # pooled
+    assert len({s["groundspeed_sd_own_kt"] for s in d["segments"]}) == 16
     assert [s["point"] for s in d["segments"]] == [w[2] for w in windows]
     series = d["global_timeseries"]
     for name, true in zip(("k1", "k2"), LEGS_TRUE_K):

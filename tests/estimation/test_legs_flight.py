@@ -130,3 +130,20 @@ def test_detected_point_with_too_few_legs_left_out(flown):
 def test_no_steady_segment_says_what_to_do(flown):
     with pytest.raises(FlightDataError, match=r"no steady segment of 500 s or more \(track ±3°"):
         analyze_leg_flight(flown[0], min_leg_s=500.0)
+
+
+@pytest.mark.filterwarnings("ignore:time-series fit")
+def test_two_altitude_bands_warn_that_the_time_series_has_one_wind():
+    from dataclasses import replace
+
+    low, _, _ = simulate_leg_flight(ias_kt=(80, 140), rate_hz=1.0, seed=8)
+    high, _, _ = simulate_leg_flight(ias_kt=(90, 150), pressure_alt_ft=8000.0, rate_hz=1.0,
+                                     seed=9)
+    fields = ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "alt_m", "ps_pa", "oat_k")
+    both = replace(low, time_s=np.r_[low.time_s, high.time_s + low.time_s[-1] + 60.0],
+                   **{f: np.r_[getattr(low, f), getattr(high, f)] for f in fields})
+    with pytest.warns(UserWarning, match="one wind for the record, but the legs span 2 altitude bands"):
+        res = analyze_leg_flight(both)
+    assert len(res["points"]) == 4 and len(res["fit"].group_labels) == 2
+    assert res["leg_sd_own_mps"].shape == (16,)
+    assert np.ptp(res["legs"].groundspeed_sd_mps) == 0.0         # pooled
