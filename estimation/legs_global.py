@@ -37,15 +37,22 @@ BAND_FT = 1000.0          # width of an altitude band for `per-band` winds
 
 
 def wind_groups(legs, mode, band_ft=BAND_FT):
-    """(group index of each leg, group labels): per point, or per pressure-altitude band of
-    `band_ft` counted up from the lowest point (each point by its legs' mean altitude), labelled
-    by the band's mean altitude."""
+    """(group index of each leg, group labels): per point, or per pressure-altitude band (each
+    point by its legs' mean altitude; a band spans `band_ft` up from its lowest point, the next
+    begins at the first point above), labelled by the band's mean altitude."""
     points = legs.points()
     alt_ft = np.array([np.mean(legs.pressure_alt_m[legs.indices(p)]) for p in points]) / 0.3048
     if mode == "per-point":
         keys = list(range(len(points)))
     else:
-        keys = [int(np.floor((a - alt_ft.min()) / band_ft + 1e-9)) for a in alt_ft]
+        # bands grow upward from the lowest point: a point more than `band_ft` above its band's
+        # lowest starts the next one (points 25 ft apart never straddle a fixed boundary)
+        keys, start = [0] * len(points), None
+        for rank, i in enumerate(np.argsort(alt_ft, kind="stable")):
+            if start is None or alt_ft[i] - start > band_ft + 1e-9:
+                start = alt_ft[i]
+                band = rank
+            keys[i] = band
     order = list(dict.fromkeys(keys))
     group = np.empty(legs.n, dtype=int)
     for p, key in zip(points, keys):

@@ -15,7 +15,8 @@ from pitotcal.core.units import KT_TO_MPS
 from .legs import solve_points
 from .legs_global import fit_legs
 
-__all__ = ["POINT_KEYS", "analyze_legs", "legs_json", "legs_summary", "plot_legs"]
+__all__ = ["POINT_KEYS", "analyze_legs", "flight_legs_json", "flight_legs_text", "legs_json",
+           "legs_summary", "plot_legs"]
 
 # The keys of each entry of the JSON's "points" list, in order.
 POINT_KEYS = ("point", "ias_kt", "tas_kt", "tas_2sigma_kt", "wind_speed_kt", "wind_from_deg",
@@ -118,9 +119,12 @@ def _global_text(fit):
     return "\n".join(out)
 
 
-def plot_legs(points, fit, path):
-    """Per-point ΔV (95 % bars) and the global curve with its band, saved to `path`."""
+def plot_legs(points, fit, path, series=None):
+    """Per-point ΔV (95 % bars) and the global curve with its band, saved to `path`; with
+    `series` (an IdentificationResult) its curve and 2σ band too."""
     from matplotlib.figure import Figure
+
+    from pitotcal.io.atomic import save_figure
 
     fig = Figure(figsize=(7.0, 4.5), layout="constrained")
     ax = fig.subplots()
@@ -128,10 +132,17 @@ def plot_legs(points, fit, path):
         lo, hi = fit.vi_range_kt
         vi = np.linspace(lo, hi, 200)
         dv, half = fit.delta_v_kt(vi)
+        name = "global fit" if series is None else "global fit over the legs"
         ax.fill_between(vi, dv - half, dv + half, color="C0", alpha=0.25,
-                        label=f"global fit ({fit.model}) ±2σ" if fit.noise_source == "stated"
-                        else f"global fit ({fit.model}), 95 % band")
+                        label=f"{name} ({fit.model}) ±2σ" if fit.noise_source == "stated"
+                        else f"{name} ({fit.model}), 95 % band")
         ax.plot(vi, dv, color="C0", lw=2)
+    if series is not None:
+        vi = np.linspace(min(s.ias_kt for s in points), max(s.ias_kt for s in points), 200)
+        dv, half = series.delta_v_kt(vi)
+        ax.fill_between(vi, dv - half, dv + half, color="C2", alpha=0.18,
+                        label=f"time-series fit ({series.model}) ±2σ, colored residuals")
+        ax.plot(vi, dv, color="C2", lw=1.5, ls="--")
     ias = np.array([s.ias_kt for s in points])
     dv_pts = np.array([s.dv_kt for s in points])
     half = np.array([s.dv_half_kt for s in points])
@@ -145,5 +156,62 @@ def plot_legs(points, fit, path):
     ax.set_ylabel("ΔV_pc = V_c − V_ic, kt")
     ax.set_title("Airspeed correction from GPS legs: per point vs one global fit")
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     return path
+
+
+def _series_dict(res):
+    return None if res["series"] is None else res["series"].to_dict()
+
+
+def flight_legs_json(res, source):
+    """The JSON of `pitotcal legs FLIGHT`: that of a leg file plus input "flight", detection,
+    segments [{leg, point, start_s, end_s, groundspeed_kt, track_deg, groundspeed_sd_kt
+    (pooled, as used), groundspeed_sd_own_kt, ias_kt}] and global_timeseries (the identify JSON of the legs' samples, or null)."""
+    from pitotcal.io.jsonfile import json_ready
+
+    legs = res["legs"]
+    out = legs_json(legs, res["points"], res["fit"], res["notes"])
+    out["source"] = str(source)
+    segments = [{"leg": i + 1, "point": legs.point[i], "start_s": float(lo), "end_s": float(hi),
+                 "groundspeed_kt": legs.groundspeed_mps[i] / KT_TO_MPS,
+                 "track_deg": legs.track_deg[i],
+                 "groundspeed_sd_kt": legs.groundspeed_sd_mps[i] / KT_TO_MPS,
+                 "groundspeed_sd_own_kt": res["leg_sd_own_mps"][i] / KT_TO_MPS,
+                 "ias_kt": legs.ias_kt[i]} for i, (lo, hi) in enumerate(res["spans"])]
+    out.update({"input": "flight", "detection": res["detection"], "segments": segments,
+                "global_timeseries": _series_dict(res)})
+    return json_ready(out)
+
+
+def flight_legs_text(res):
+    """The legs found in a flight and the time-series fit beside the per-point ΔV."""
+    legs = res["legs"]
+    how = ("given windows" if res["detection"] == "windows" else
+           "detected: " + ", ".join(f"{k} {v:g}" for k, v in res["detection"].items()))
+    pooled = legs.groundspeed_sd_mps[0] / KT_TO_MPS
+    lines = [f"Legs from the time series ({how}):",
+             (f"  {'leg':>4}{'point':>7}{'start s':>10}{'end s':>9}{'KIAS':>7}{'GS kt':>8}"
+              f"{'track':>7}{'sd kt':>7}   (sd: the leg's own; pooled {pooled:.2f} kt used)")]
+    for i, (lo, hi) in enumerate(res["spans"]):
+        lines.append(f"  {i + 1:4d}{legs.point[i]:>7}{lo:10.1f}{hi:9.1f}{legs.ias_kt[i]:7.1f}"
+                     f"{legs.groundspeed_mps[i] / KT_TO_MPS:8.2f}{legs.track_deg[i]:7.1f}"
+                     f"{res['leg_sd_own_mps'][i] / KT_TO_MPS:7.2f}")
+    series, fit = res["series"], res["fit"]
+    if series is None:
+        return "\n".join(lines)
+    d = series.to_dict()
+    lines += ["", (f"Global fit over the legs' time series (identify, {series.n_samples} samples, "
+                   f"one wind, colored-residual 2σ; {'converged' if series.converged else 'DID NOT CONVERGE'}):")]
+    for name in d["parameters"]:
+        p = d["parameters"][name]
+        lines.append(f"  {name:<16}{p['value']:>12.5g}  ±{2 * p['std']:.2g} {p.get('unit') or ''}")
+    lines += ["", "ΔV at each point, kt (±: 95 % half-width):",
+              f"  {'point':<7}{'KIAS':>6}{'classic':>14}{'leg global':>14}{'time series':>14}"]
+    for s in res["points"]:
+        dv_s, h_s = series.delta_v_kt(s.ias_kt)
+        glob = ("n/a" if fit is None else
+                "{:+.2f}±{:.2f}".format(*(float(x) for x in fit.delta_v_kt(s.ias_kt))))
+        lines.append(f"  {s.point:<7}{s.ias_kt:6.1f}{s.dv_kt:+9.2f}±{_fmt(s.dv_half_kt, '.2f'):<4}"
+                     f"{glob:>14}{float(dv_s):+9.2f}±{float(h_s):.2f}")
+    return "\n".join(lines)

@@ -18,7 +18,7 @@ from pitotcal.core.models import get_model
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS, wind_vector_mps
 from pitotcal.io.legs_csv import LegData
 
-__all__ = ["LEGS_TRUE_K", "LegTruth", "simulate_legs"]
+__all__ = ["LEGS_TRUE_K", "LegTruth", "simulate_leg_flight", "simulate_legs"]
 
 # A light aircraft's pressure error, Δp/q_c = 0.03 − 40 Pa / q_ci: ΔV ≈ −0.9 kt at 70 kt,
 # +1.6 kt at 160 kt (the classic leg data's speed range).
@@ -108,3 +108,88 @@ def simulate_legs(ias_kt=(70, 85, 100, 115, 130, 145, 160), tracks_deg=(0, 90, 1
     truth = LegTruth(model=pe.name, k=tuple(k), ias_kt=ias, tas_mps=tas,
                      dv_kt=(vc - ias * KT_TO_MPS) / KT_TO_MPS, wind_n_mps=w[0], wind_e_mps=w[1])
     return legs, truth
+
+
+def _schedule(ias_kt, headings_deg, leg_s, turn_rate_dps, accel_kt_s):
+    """Pieces (duration s, heading start, heading change, IAS start, IAS end, point or None):
+    a straight leg per heading and point, joined by constant-rate turns; between points the
+    turn also changes the speed (at `accel_kt_s`, the turn slowed to last as long)."""
+    pieces, heading, speed = [], float(headings_deg[0]), float(ias_kt[0])
+    for p, ias in enumerate(ias_kt):
+        for j, target in enumerate(headings_deg):
+            change = (float(target) - heading + 180.0) % 360.0 - 180.0
+            if change == -180.0:
+                change = 180.0                      # a reversal turns right
+            dur = max(abs(change) / turn_rate_dps, abs(float(ias) - speed) / accel_kt_s)
+            if dur > 0:
+                pieces.append((dur, heading, change, speed, float(ias), None))
+            heading, speed = float(target) % 360.0, float(ias)
+            pieces.append((float(leg_s), heading, 0.0, speed, speed, str(p + 1)))
+    return pieces
+
+
+def simulate_leg_flight(ias_kt=(70, 100, 130, 160), headings_deg=(0, 90, 180, 270),
+                        leg_s=60.0, turn_rate_dps=3.0, accel_kt_s=1.0, pressure_alt_ft=3000.0,
+                        wind_speed_kt=15.0, wind_from_deg=250.0, model="inverse",
+                        k=LEGS_TRUE_K, turbulence_mps=0.5, turbulence_length_m=300.0,
+                        gps_noise_mps=0.05, qc_noise_pa=0.5, rate_hz=10.0, seed=0):
+    """A leg flight as a time series: straight legs on `headings_deg` at every IAS, joined by
+    turns, logged like a flight CSV (compressible air data; the static port's reading `ps_pa`).
+
+    The pilot holds the indicated airspeed and the heading; the ground velocity is the air
+    velocity plus the wind plus horizontal gusts (first-order Gauss-Markov per component, time
+    constant L/V, rms `turbulence_mps`) plus white GPS noise. The truth is that of
+    `simulate_legs` (ISA at `pressure_alt_ft`, all the position error in the static source).
+
+    Returns
+    -------
+    (Flight, LegTruth, windows)
+        `windows`: list of (start_s, end_s, point label) of the straight legs.
+    """
+    from pitotcal.core.flight import Flight
+    from pitotcal.core.units import density_kgm3
+
+    pe = get_model(model)
+    rate = number("rate_hz", rate_hz, 0.5, 1000.0)
+    rng = np.random.default_rng(integer("seed", seed, 0))
+    pieces = _schedule(ias_kt, headings_deg, number("leg_s", leg_s, 5.0, 3600.0),
+                       number("turn_rate_dps", turn_rate_dps, 0.1, 30.0),
+                       number("accel_kt_s", accel_kt_s, 0.05, 20.0))
+    starts = np.cumsum([0.0] + [p[0] for p in pieces])
+    t = np.arange(0.0, starts[-1], 1.0 / rate)
+    piece = np.searchsorted(starts, t, side="right") - 1
+    frac = (t - starts[piece]) / np.array([p[0] for p in pieces])[piece]
+    col = np.array([p[1:5] for p in pieces])[piece]
+    heading = np.radians(col[:, 0] + frac * col[:, 1])
+    ias = col[:, 2] + frac * (col[:, 3] - col[:, 2])
+    alt_m = number("pressure_alt_ft", pressure_alt_ft) * FT_TO_M
+    ps = float(airdata.static_pressure_pa(alt_m))
+    oat_k = 288.15 - 0.0065 * alt_m
+    qci = airdata.qc_from_cas_pa(ias * KT_TO_MPS)
+    qc = qci / (1.0 - pe(k, qci))
+    tas = airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)
+    wn, we = wind_vector_mps(wind_speed_kt * KT_TO_MPS, wind_from_deg)
+    phi = np.exp(-np.mean(tas) / (rate * turbulence_length_m))
+    gust = np.zeros((t.size, 2))
+    shocks = rng.normal(0.0, turbulence_mps * np.sqrt(1.0 - phi ** 2), size=gust.shape)
+    gust[0] = rng.normal(0.0, turbulence_mps, size=2)
+    for i in range(1, t.size):
+        gust[i] = phi * gust[i - 1] + shocks[i]
+    noise = rng.normal(0.0, gps_noise_mps, size=(t.size, 2))
+    vn = tas * np.cos(heading) + float(wn) + gust[:, 0] + noise[:, 0]
+    ve = tas * np.sin(heading) + float(we) + gust[:, 1] + noise[:, 1]
+    ps_ind = ps + (qc - qci)
+    flight = Flight(time_s=t, qci_pa=qci + rng.normal(0.0, qc_noise_pa, t.size),
+                    gps_vn_mps=vn, gps_ve_mps=ve, rho_kgm3=density_kgm3(ps_ind, oat_k),
+                    alt_m=airdata.pressure_altitude_m(ps_ind), ps_pa=ps_ind,
+                    oat_k=np.full(t.size, oat_k), source="simulated leg flight")
+    windows = [(float(starts[i]), float(starts[i + 1]), p[5]) for i, p in enumerate(pieces)
+               if p[5] is not None]
+    ias_pts = np.asarray(ias_kt, dtype=float)
+    qci_pts = airdata.qc_from_cas_pa(ias_pts * KT_TO_MPS)
+    qc_pts = qci_pts / (1.0 - pe(k, qci_pts))
+    truth = LegTruth(model=pe.name, k=tuple(k), ias_kt=ias_pts,
+                     tas_mps=airdata.mach_from_qc(qc_pts, ps) * airdata.speed_of_sound_mps(oat_k),
+                     dv_kt=(airdata.cas_from_qc_mps(qc_pts) - ias_pts * KT_TO_MPS) / KT_TO_MPS,
+                     wind_n_mps=float(wn), wind_e_mps=float(we))
+    return flight, truth, windows

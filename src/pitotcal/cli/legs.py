@@ -1,5 +1,9 @@
 """`pitotcal legs`: the classic GPS leg methods per point, and one global fit over every leg.
 
+The input is a leg CSV (one row per leg) or a flight time series (a flight CSV or an autopilot
+log, `pitotcal.io.read_flight`), whose legs are detected as steady segments or given by
+`--windows`; a time series also gets the output-error fit of the legs' own samples.
+
 Exit status: 0 success (a global fit the legs cannot determine is a warning, `"global": null`);
 2 unusable input, one stderr line naming file, column and row; 3 a point whose legs cannot
 determine TAS and wind (fewer than three legs, or ground velocities on one line).
@@ -8,17 +12,28 @@ determine TAS and wind (fewer than three legs, or ground velocities on one line)
 from pathlib import Path
 
 WIND_CHOICES = ("per-band", "per-point")
+LOG_SUFFIXES = (".ulg", ".bin", ".log")
+# Detection options: flag -> (keyword of estimation.legs_flight.detect_segments, help).
+DETECT_FLAGS = {
+    "--min-leg-s": ("min_leg_s", "shortest steady segment kept as a leg, s"),
+    "--track-tol-deg": ("track_tol_deg", "track must stay within ± this, deg"),
+    "--groundspeed-tol-kt": ("groundspeed_tol_kt", "ground speed must stay within ± this, kt"),
+    "--ias-tol-kt": ("ias_tol_kt", "indicated airspeed must stay within ± this, kt"),
+    "--smooth-s": ("smooth_s", "moving average applied before the bands are checked, s"),
+}
 
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
         "legs", help="calibrate from GPS legs (3-leg, 4-leg) per point and globally",
         description="Read a leg CSV (one row per constant-speed leg: point, ias_kt, "
-                    "pressure_alt_ft, oat_c, groundspeed_kt, track_deg), solve each point by the "
-                    "classic GPS methods (3-leg closed form, 4-leg subset mean) with bounds, fit "
-                    "one pressure-error model and the winds over all legs, and print both in "
-                    "knots. The input is never modified.")
-    p.add_argument("legs", metavar="LEGS.csv", help="leg CSV (docs/interfaces.md, leg data)")
+                    "pressure_alt_ft, oat_c, groundspeed_kt, track_deg) or a flight CSV/log "
+                    "(legs detected as steady segments, or given by --windows), solve each "
+                    "point by the classic GPS methods (3-leg closed form, 4-leg subset mean) "
+                    "with bounds, fit one pressure-error model and the winds over all legs, "
+                    "and print both in knots. The input is never modified.")
+    p.add_argument("legs", metavar="LEGS.csv|FLIGHT.csv|LOG",
+                   help="leg CSV (docs/interfaces.md, leg data), flight CSV, or .ulg/.bin/.log")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the figure: per-point ΔV with 95%% bars, global curve and band")
@@ -28,28 +43,70 @@ def add_parser(subparsers):
     p.add_argument("--wind", default="per-band", metavar="MODE",
                    help="global fit: one wind per 1,000 ft pressure-altitude band (per-band) or "
                         "per point (per-point); default %(default)s")
+    g = p.add_argument_group("time-series input (flight CSV or log)")
+    g.add_argument("--windows", metavar="T0-T1,...|WINDOWS.csv", default=None,
+                   help="the legs' time windows, s ('120-180,200-260'), or a CSV with columns "
+                        "start_s, end_s and optional point; default: detect steady segments")
+    for flag, (key, text) in DETECT_FLAGS.items():
+        g.add_argument(flag, type=float, default=None, metavar="X",
+                       help=f"{text} (default: {_default(key)})")
+    g.add_argument("--point-tol-kt", type=float, default=None, metavar="KT",
+                   help="legs whose IAS differ by at most this form one point (default 3)")
+    g.add_argument("--legs-out", metavar="LEGS.csv", default=None,
+                   help="write the legs found as a leg CSV, to check by hand")
     p.set_defaults(run=run)
 
 
+def _default(key):
+    # the values of estimation.legs_flight.DETECT_DEFAULTS, without importing numpy here
+    return {"min_leg_s": 30, "track_tol_deg": 3, "groundspeed_tol_kt": 3, "ias_tol_kt": 2,
+            "smooth_s": 5}[key]
+
+
+def _is_flight(path):
+    from pitotcal.io.flight_csv import csv_kind
+
+    return path.suffix.lower() in LOG_SUFFIXES or csv_kind(path) in ("flight", "plan")
+
+
+def _series_options(args):
+    """{keyword: value} of the time-series options given."""
+    opts = {key: getattr(args, flag[2:].replace("-", "_")) for flag, (key, _) in DETECT_FLAGS.items()}
+    return {k: v for k, v in opts.items() if v is not None}
+
+
 def run(args):
-    from pitotcal.cli.common import check_output
+    from pitotcal.cli.common import check_distinct, check_output
     from pitotcal.core.checks import choice
+    from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
-    from pitotcal.estimation.legs_report import (
-        analyze_legs,
-        legs_json,
-        legs_summary,
-        plot_legs,
-    )
-    from pitotcal.io.jsonfile import write_json
-    from pitotcal.io.legs_csv import read_legs
 
     choice("model", args.model, list(MODELS))
     choice("wind", args.wind, WIND_CHOICES)
     source = Path(args.legs)
-    for option, out in (("--json", args.json), ("--plot", args.plot)):
+    if not source.is_file():
+        raise PitotcalError(f"{source}: no such file", param="legs")
+    flight = _is_flight(source)
+    outputs = {"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out}
+    for option, out in outputs.items():
         if out is not None:
-            check_output(option, out, source, "leg file")
+            check_output(option, out, source, "flight file" if flight else "leg file")
+    check_distinct(outputs)
+    if flight:
+        return _run_flight(args, source)
+    given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out")
+             if getattr(args, f[2:].replace("-", "_")) is not None]
+    if given:
+        raise PitotcalError(f"{given[0]}: only for a flight time series; {source} is a leg "
+                            f"file", param=given[0])
+    return _run_legs(args, source)
+
+
+def _run_legs(args, source):
+    from pitotcal.estimation.legs_report import analyze_legs, legs_json, legs_summary, plot_legs
+    from pitotcal.io.jsonfile import write_json
+    from pitotcal.io.legs_csv import read_legs
+
     legs = read_legs(source)
     points, fit, notes = analyze_legs(legs, model=args.model, wind=args.wind)
     print(legs_summary(legs, points, fit, notes))
@@ -60,4 +117,56 @@ def run(args):
         plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
         plot_legs(points, fit, plot_path)
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
+    return 0
+
+
+def _windows(text):
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.legs_flight import parse_windows, read_windows
+
+    if text is None:
+        return None
+    if Path(text).is_file():
+        return read_windows(text)
+    if text.lower().endswith(".csv"):
+        raise PitotcalError(f"--windows {text}: no such file", param="windows")
+    return parse_windows(text)
+
+
+def _run_flight(args, source):
+    from pitotcal.core.checks import number
+    from pitotcal.estimation.legs_flight import analyze_leg_flight
+    from pitotcal.estimation.legs_report import (
+        flight_legs_json,
+        flight_legs_text,
+        legs_summary,
+        plot_legs,
+    )
+    from pitotcal.io import read_flight
+    from pitotcal.io.jsonfile import write_json
+    from pitotcal.io.legs_csv import write_legs
+
+    detect = {k: number(k, v, 0.0, lo_open=True) for k, v in _series_options(args).items()}
+    tol = 3.0 if args.point_tol_kt is None else number("--point-tol-kt", args.point_tol_kt,
+                                                        0.0, 50.0, lo_open=True)
+    windows = _windows(args.windows)
+    flight = read_flight(source)
+    res = analyze_leg_flight(flight, windows, model=args.model, wind=args.wind,
+                             point_tol_kt=tol, **detect)
+    print(legs_summary(res["legs"], res["points"], res["fit"], res["notes"]))
+    print("\n" + flight_legs_text(res))
+    wrote = []
+    if args.legs_out is not None:
+        write_legs(res["legs"], args.legs_out,
+                   comments=[f"legs found in {source} by pitotcal legs"])
+        wrote.append(args.legs_out)
+    if args.json is not None:
+        write_json(args.json, flight_legs_json(res, source))
+        wrote.append(args.json)
+    if args.plot is not None:
+        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+        plot_legs(res["points"], res["fit"], plot_path, series=res["series"])
+        wrote.append(plot_path)
+    if wrote:
+        print("\n" + "\n".join(f"Wrote {w}" for w in wrote))
     return 0
