@@ -28,6 +28,7 @@ import numpy as np
 from pitotcal.core import airdata
 from pitotcal.core.errors import ObservabilityError, PitotcalError
 from pitotcal.core.models import get_model
+from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import KT_TO_MPS, wind_polar
 
 __all__ = ["WIND_MODES", "LegFit", "delta_v_compressible_kt", "fit_legs", "wind_groups"]
@@ -112,17 +113,8 @@ class LegFit:
         model = get_model(self.model)
         k = self.coefficients
         dv = delta_v_compressible_kt(model, k, vi_kt)
-        grad = []
-        for i in range(k.size):
-            h = 1e-6 * max(1.0, abs(k[i]))
-            up, dn = k.copy(), k.copy()
-            up[i] += h
-            dn[i] -= h
-            grad.append((delta_v_compressible_kt(model, up, vi_kt)
-                         - delta_v_compressible_kt(model, dn, vi_kt)) / (2 * h))
-        g = np.array(grad)
-        var = np.einsum("i...,ij,j...->...", g, self.coef_cov, g)
-        return dv, self.half_width_factor * np.sqrt(np.maximum(var, 0.0))
+        g = gradient(lambda kk: delta_v_compressible_kt(model, kk, vi_kt), k)
+        return dv, self.half_width_factor * band(g, self.coef_cov)
 
     def correction_table(self, step_kt=None):
         """Rows {vi_kt, dv_kt, dv_2sigma_kt, vc_kt} from the lowest to the highest V_ic flown."""

@@ -5,9 +5,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pitotcal.core.models import delta_v_kt, get_model
+from pitotcal.core.propagation import band as _band
+from pitotcal.core.propagation import gradient as _gradient
 
-from .propagation import band as _band
-from .propagation import gradient as _gradient
 from .unknowns import COEFS
 
 __all__ = ["IdentificationResult"]

@@ -26,9 +26,8 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.models import get_model, qc_from_qci_pa
+from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import kt_to_mps, m_to_ft
-
-from .propagation import band, gradient
 
 __all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "plot_altimeter_correction",
            "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",

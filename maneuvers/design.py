@@ -32,7 +32,7 @@ from pitotcal.core.information import (
 )
 from pitotcal.core.models import get_model
 from pitotcal.core.scenario import true_k
-from pitotcal.core.units import G0_MPS2, kt_to_mps, incompressible_qc_pa
+from pitotcal.core.units import G0_MPS2, incompressible_qc_pa, kt_to_mps
 
 __all__ = [
     "CRITERIA",

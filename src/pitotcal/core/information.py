@@ -20,6 +20,7 @@ import numpy as np
 
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 from pitotcal.core.models import delta_v_kt, qci_from_qc_pa
+from pitotcal.core.propagation import band, gradient
 
 __all__ = ["ResidualNoise", "delta_v_band_kt", "least_squares_covariance",
            "predicted_qci_pa", "qci_sensitivities", "residual_covariance",
@@ -129,13 +130,5 @@ def least_squares_covariance(jac, sigma):
 def delta_v_band_kt(model, k, cov_k, vi_kt):
     """Two-sigma half-width of the airspeed correction ΔV at indicated `vi_kt` (delta method,
     the coefficients' covariance `cov_k`)."""
-    k = np.asarray(k, dtype=float)
-    grads = []
-    for i in range(k.size):
-        h = 1e-6 * max(1.0, abs(k[i]))
-        up, dn = k.copy(), k.copy()
-        up[i] += h
-        dn[i] -= h
-        grads.append((delta_v_kt(model, up, vi_kt) - delta_v_kt(model, dn, vi_kt)) / (2 * h))
-    g = np.array(grads)
-    return 2.0 * np.sqrt(np.maximum(np.einsum("i...,ij,j...->...", g, cov_k, g), 0.0))
+    g = gradient(lambda kk: delta_v_kt(model, kk, vi_kt), k)
+    return 2.0 * band(g, cov_k)
