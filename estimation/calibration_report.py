@@ -16,6 +16,7 @@ import tomllib
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
+from pitotcal.io.atomic import atomic_open
 
 from . import compliance as comp
 
@@ -358,7 +359,9 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     context = build_report(result, flight=flight, aircraft_rows=rows, regulation=regulation,
                            speed_range_kt=speed_range_kt, inputs=inputs, options=options,
                            ident=ident)
-    Path(html_path).write_text(render_html(context), encoding="utf-8")
+    html = render_html(context)
+    with atomic_open(html_path, "w", encoding="utf-8") as fh:
+        fh.write(html)
     written = [html_path]
     if json_path is not None:
         from pitotcal.io.jsonfile import write_json

@@ -145,5 +145,7 @@ def plot_legs(points, fit, path):
     ax.set_ylabel("ΔV_pc = V_c − V_ic, kt")
     ax.set_title("Airspeed correction from GPS legs: per point vs one global fit")
     ax.legend(fontsize=8)
-    fig.savefig(path, dpi=110)
+    from pitotcal.io.atomic import save_figure
+
+    save_figure(fig, path, dpi=110)
     return path

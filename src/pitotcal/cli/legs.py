@@ -32,7 +32,7 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_output
+    from pitotcal.cli.common import check_distinct, check_output
     from pitotcal.core.checks import choice
     from pitotcal.core.models import MODELS
     from pitotcal.estimation.legs_report import (
@@ -50,14 +50,19 @@ def run(args):
     for option, out in (("--json", args.json), ("--plot", args.plot)):
         if out is not None:
             check_output(option, out, source, "leg file")
+    plot_path = None if args.plot is None else \
+        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+    check_distinct({"--json": args.json, "--plot": plot_path})
     legs = read_legs(source)
     points, fit, notes = analyze_legs(legs, model=args.model, wind=args.wind)
-    print(legs_summary(legs, points, fit, notes))
+    # files first, then the summary: a reader that goes away early never costs a file
     if args.json is not None:
         write_json(args.json, legs_json(legs, points, fit, notes))
-        print(f"\nWrote {args.json}")
-    if args.plot is not None:
-        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+    if plot_path is not None:
         plot_legs(points, fit, plot_path)
+    print(legs_summary(legs, points, fit, notes))
+    if args.json is not None:
+        print(f"\nWrote {args.json}")
+    if plot_path is not None:
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
     return 0

@@ -57,6 +57,7 @@ from pitotcal.core.flight import Flight
 from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import density_kgm3
 
+from .atomic import atomic_open
 from .flight_checks import (
     check_ps_oat,
     check_rho,
@@ -86,8 +87,9 @@ def write_flight_csv(flight, path, comments=None):
             data.append(getattr(flight, name))
     meta = {**flight.meta, **(comments or {})}
     header = "".join(f"# {key}: {value}\n" for key, value in meta.items()) + ",".join(columns)
-    np.savetxt(path, np.column_stack(data), delimiter=",", header=header, comments="",
-               fmt=["%.4f"] + ["%.9g"] * (len(columns) - 1))
+    with atomic_open(path, "w") as fh:          # whole or not at all: never a spliced file
+        np.savetxt(fh, np.column_stack(data), delimiter=",", header=header, comments="",
+                   fmt=["%.4f"] + ["%.9g"] * (len(columns) - 1))
     return path
 
 

@@ -29,6 +29,7 @@ import numpy as np
 from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
+from pitotcal.io.atomic import atomic_open
 
 __all__ = ["LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
@@ -156,7 +157,7 @@ def write_legs(legs, path, comments=()):
     extra = {"duration_s": legs.duration_s,
              "groundspeed_sd_kt": legs.groundspeed_sd_mps / KT_TO_MPS}
     cols += [c for c, v in extra.items() if np.any(np.isfinite(v))]
-    with open(path, "w", newline="", encoding="utf-8") as f:
+    with atomic_open(path, "w", newline="", encoding="utf-8") as f:
         f.writelines(f"# {line}\n" for line in comments)
         w = csv.writer(f, lineterminator="\n")
         w.writerow(cols)

@@ -10,6 +10,7 @@ import numpy as np
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.plan import PLAN_COLUMNS, PLAN_RANGES, Plan
 from pitotcal.io.atomic import atomic_open
+from pitotcal.io.jsonfile import json_ready
 
 __all__ = ["read_plan", "write_plan"]
 
@@ -19,7 +20,7 @@ def write_plan(plan, path):
     path = Path(path)
     with atomic_open(path, "w", newline="") as fh:
         for key, value in plan.settings.items():
-            fh.write(f"# {key}: {json.dumps(value)}\n")
+            fh.write(f"# {key}: {json.dumps(json_ready(value), allow_nan=False)}\n")
         writer = csv.writer(fh)
         writer.writerow(PLAN_COLUMNS)
         data = np.column_stack([plan.column(c) for c in PLAN_COLUMNS])
