@@ -232,7 +232,8 @@ def write_autothrottle_csv(plan, path, rate_hz=None):
     with atomic_open(path, "w", newline="") as fh:
         for key in ("profile", "cas_min_kt", "cas_max_kt", "altitude_m", "accel_max_mps2"):
             if key in plan.settings:
-                fh.write(f"# {key}: {json.dumps(json_ready(plan.settings[key]), allow_nan=False)}\n")
+                value = json.dumps(json_ready(plan.settings[key]), allow_nan=False)
+                fh.write(f"# {key}: {value}\n")
         writer = csv.writer(fh)
         writer.writerow(list(sp))
         for row in zip(*sp.values()):
