@@ -72,8 +72,8 @@ def test_identify_with_a_glitch_cell_gives_the_truth_and_the_warning(tmp_path, c
 
 
 @pytest.mark.parametrize("scale, offset, match", [
-    (1e3, 0.0, r"median step 20 looks like milliseconds \(50 Hz\); expected seconds "
-               r"\(time_s = value / 1000\)"),
+    (1e3, 0.0, (r"median step 20 looks like milliseconds \(50 Hz\); expected seconds "
+                r"\(time_s = value / 1000\)")),
     (1e6, 0.0, r"median step 20000 looks like microseconds \(50 Hz\)"),
     (1e3, 1.7e12, r"median step 20 looks like milliseconds \(Unix time\) \(50 Hz\)"),
     (1.0, 0.0, None),

@@ -279,7 +279,7 @@ def check_time_units(name, t):
     if t[0] >= _UNIX_TIME_MIN_S:
         import datetime
 
-        start = datetime.datetime.fromtimestamp(float(t[0]), datetime.timezone.utc)
+        start = datetime.datetime.fromtimestamp(float(t[0]), datetime.UTC)
         text = (f"{name}: column time_s looks like Unix time in seconds (starts "
                 f"{start:%Y-%m-%d %H:%M:%S} UTC); used as seconds (only differences matter)")
         warnings.warn(text, stacklevel=3)

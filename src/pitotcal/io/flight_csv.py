@@ -66,9 +66,9 @@ from .flight_checks import (
     check_time_units,
     check_units,
     check_vertical_speed,
-    looks_utf16,
     check_window,
     drop_bad_rows,
+    looks_utf16,
     window_text,
 )
 
