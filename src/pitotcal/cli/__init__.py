@@ -20,8 +20,17 @@ from pitotcal import __version__
 COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study", "legs", "report")
 
 
+class _Parser(argparse.ArgumentParser):
+    """An option value argparse refuses (``--runs abc``, ``--engine xyz``, a missing argument)
+    is one line naming the flag, exit status 2, like our own errors: not the usage block.
+    Subcommand parsers are of this class too (argparse makes them of their parent's)."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: {message} (see {self.prog} --help)\n")
+
+
 def build_parser():
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="pitotcal",
         description="In-flight GPS calibration of pitot-static systems: plan the maneuver, "
                     "simulate it, identify the pressure error and the wind with honest bounds.")
