@@ -16,7 +16,7 @@ import tomllib
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.io.atomic import atomic_open
+from pitotcal.io.atomic import atomic_open, atomic_path
 
 from . import compliance as comp
 
@@ -300,11 +300,13 @@ def write_pdf(html_path, pdf_path):
                     if shutil.which(b)), None)
     if browser is None:
         raise PitotcalError("--pdf needs Chromium on PATH (Debian: apt-get install chromium)")
-    cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
-           f"--print-to-pdf={Path(pdf_path).resolve()}", Path(html_path).resolve().as_uri()]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
-    if proc.returncode != 0 or not Path(pdf_path).is_file():
-        raise PitotcalError(f"--pdf: Chromium failed ({proc.stderr.strip()[-200:]})")
+    # printed to a temporary file beside it, renamed when whole (pitotcal.io.atomic)
+    with atomic_path(pdf_path) as tmp:
+        cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+               f"--print-to-pdf={Path(tmp).resolve()}", Path(html_path).resolve().as_uri()]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
+        if proc.returncode != 0 or not Path(tmp).stat().st_size:
+            raise PitotcalError(f"--pdf: Chromium failed ({proc.stderr.strip()[-200:]})")
     return pdf_path
 
 
