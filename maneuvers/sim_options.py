@@ -101,6 +101,28 @@ def check_plan(plan):
         raise PitotcalError("plan airspeeds must be > 0")
 
 
+# Issue 15: the largest pressure error simulated, |dp/q_c| (beyond it the sensor would read
+# zero or negative impact pressure: no pitot-static system).
+MAX_PRESSURE_ERROR = 0.5
+
+
+def _check_pressure_error(opts, plan):
+    """The true coefficients keep |dp/q_c| <= MAX_PRESSURE_ERROR over the plan's q_c."""
+    model = get_model(opts.model)
+    qc = np.asarray(plan.qc_pa, dtype=float)
+    qc = qc[np.isfinite(qc) & (qc > 0)]
+    with np.errstate(all="ignore"):
+        ratio = np.asarray(model(opts.k, qc), dtype=float)
+    worst = float(np.max(np.abs(ratio))) if ratio.size else 0.0
+    if not worst <= MAX_PRESSURE_ERROR:
+        names = ", ".join(f"{n} {v:g}" for n, v in zip(model.params, opts.k))
+        raise PitotcalError(
+            f"{names}: the {model.name} pressure error dp/qc reaches {worst:.3g} on the "
+            f"plan's q_c {qc.min():.0f}-{qc.max():.0f} Pa; at most {MAX_PRESSURE_ERROR:g} "
+            "(beyond it the sensor reads no impact pressure)", param=model.params[0],
+            mentions=model.params[1:])
+
+
 def _check_samples(rate_hz, span_s):
     """At least `MIN_SAMPLES` and at most `MAX_SAMPLES` over the plan; the rate suggested is
     computed from those limits and passes them."""
@@ -172,6 +194,7 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
         air_data=choice("air_data", air_data, AIR_DATA_MODES))
     span_s = float(plan.time_s[-1] - plan.time_s[0])
     _check_samples(opts.rate_hz, span_s)
+    _check_pressure_error(opts, plan)
     if opts.gps_latency_s >= span_s:
         raise PitotcalError(f"gps_latency_s {opts.gps_latency_s:g} must be shorter than the "
                             f"plan's {span_s:g} s (typical receivers: 0-0.5 s)",

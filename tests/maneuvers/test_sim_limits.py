@@ -87,3 +87,17 @@ def test_a_duration_beyond_the_longest_maneuver_says_why():
                                             "s: a calibration maneuver is minutes long"):
         plan_maneuver("continuous", 60.0, 100.0, 600.0, 300.0, 1e9, 30.0, 5.0, 270.0,
                       dt_s=333333.0)
+
+
+def test_a_pressure_error_beyond_half_of_qc_is_refused_naming_the_flags(tmp_path, capsys):
+    from pitotcal.cli import main
+    from pitotcal.io.plan_csv import write_plan
+
+    path = write_plan(circle_plan(duration_s=30.0), tmp_path / "plan.csv")
+    status = main(["simulate", str(path), "-o", str(tmp_path / "f.csv"), "--k2=-1e6"])
+    err = capsys.readouterr().err
+    assert status == 2 and err.count("\n") == 1
+    assert err.startswith("pitotcal simulate: --k1 0.02, --k2 -1e+06: the inverse pressure error "
+                          "dp/qc reaches 1.26e+03 on the plan's q_c 794-")
+    flight, _ = simulate(circle_plan(duration_s=30.0), k=(0.3, -100.0), rate_hz=5.0)
+    assert flight.qci_pa.min() > 0
