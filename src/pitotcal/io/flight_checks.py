@@ -344,3 +344,26 @@ def looks_utf16(head):
                 sum(32 <= b < 127 or b in (9, 10, 13) for b in text) > 0.9 * len(text):
             return True
     return False
+
+
+def implausible_samples(name, t, **columns):
+    """Mask of the samples with a finite value outside `PLAUSIBLE` in any of `columns`
+    ({column name: array}; None skipped), and the warning naming the first one (or None)."""
+    mask = np.zeros(t.size, dtype=bool)
+    first = None
+    for c, v in columns.items():
+        if v is None:
+            continue
+        v = np.asarray(v, dtype=float)
+        off = np.isfinite(v) & ~_plausible(c, v)
+        if off.any() and (first is None or np.argmax(off) < first[0]):
+            first = (int(np.argmax(off)), c, float(v[np.argmax(off)]))
+        mask |= off
+    if first is None:
+        return mask, None
+    i, c, value = first
+    lo, hi = PLAUSIBLE[c]
+    text = (f"{name}: cut {int(mask.sum())} samples with implausible values (first: {c} "
+            f"{value:g} at {t[i]:.2f} s, outside {lo:g} to {hi:g})")
+    warnings.warn(text, stacklevel=3)
+    return mask, text
