@@ -131,3 +131,21 @@ def test_a_utf16_csv_is_named_utf16(tmp_path, encoding):
     path.write_bytes(text.encode(encoding))
     with pytest.raises(FlightDataError, match="UTF-16 text \\(save it as UTF-8"):
         read_flight(path)
+
+
+def test_utf16_leg_and_plan_files_are_named_utf16(tmp_path):
+    from plans import circle_plan
+
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.io.legs_csv import read_legs
+    from pitotcal.io.plan_csv import read_plan, write_plan
+
+    legs = tmp_path / "legs.csv"
+    legs.write_bytes("point,ias_kt,pressure_alt_ft,oat_c,groundspeed_kt,track_deg\n"
+                     "A,80,3000,10,85,0\n".encode("utf-16"))
+    with pytest.raises(FlightDataError, match="UTF-16 text"):
+        read_legs(legs)
+    plan = write_plan(circle_plan(duration_s=20.0), tmp_path / "plan.csv")
+    plan.write_bytes(plan.read_text().encode("utf-16"))
+    with pytest.raises(PitotcalError, match="cannot read plan: UTF-16 text"):
+        read_plan(plan)
