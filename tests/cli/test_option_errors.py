@@ -32,3 +32,13 @@ def test_a_refused_option_value_is_one_line_naming_the_flag(argv, line, capsys):
         assert err == line + "\n"
     else:
         assert err.startswith("pitotcal: argument COMMAND: invalid choice: 'nope'")
+
+
+def test_a_negative_number_in_exponent_form_is_a_value(tmp_path, capsys):
+    from plans import circle_plan
+
+    from pitotcal.io.plan_csv import write_plan
+
+    path = write_plan(circle_plan(duration_s=20.0), tmp_path / "plan.csv")
+    assert main(["simulate", str(path), "-o", str(tmp_path / "f.csv"), "--k2", "-1e6"]) == 2
+    assert "--k2 -1e+06: the inverse pressure error" in capsys.readouterr().err
