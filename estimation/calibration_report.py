@@ -16,6 +16,7 @@ import tomllib
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
+from pitotcal.io.atomic import atomic_open, atomic_path
 
 from . import compliance as comp
 
@@ -299,11 +300,13 @@ def write_pdf(html_path, pdf_path):
                     if shutil.which(b)), None)
     if browser is None:
         raise PitotcalError("--pdf needs Chromium on PATH (Debian: apt-get install chromium)")
-    cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
-           f"--print-to-pdf={Path(pdf_path).resolve()}", Path(html_path).resolve().as_uri()]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
-    if proc.returncode != 0 or not Path(pdf_path).is_file():
-        raise PitotcalError(f"--pdf: Chromium failed ({proc.stderr.strip()[-200:]})")
+    # printed to a temporary file beside it, renamed when whole (pitotcal.io.atomic)
+    with atomic_path(pdf_path) as tmp:
+        cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+               f"--print-to-pdf={Path(tmp).resolve()}", Path(html_path).resolve().as_uri()]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
+        if proc.returncode != 0 or not Path(tmp).stat().st_size:
+            raise PitotcalError(f"--pdf: Chromium failed ({proc.stderr.strip()[-200:]})")
     return pdf_path
 
 
@@ -358,7 +361,9 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     context = build_report(result, flight=flight, aircraft_rows=rows, regulation=regulation,
                            speed_range_kt=speed_range_kt, inputs=inputs, options=options,
                            ident=ident)
-    Path(html_path).write_text(render_html(context), encoding="utf-8")
+    html = render_html(context)
+    with atomic_open(html_path, "w", encoding="utf-8") as fh:
+        fh.write(html)
     written = [html_path]
     if json_path is not None:
         from pitotcal.io.jsonfile import write_json

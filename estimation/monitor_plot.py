@@ -47,7 +47,9 @@ def plot(result, path=None):
     kinds = ", ".join(f"{a['kind']} at {a['start_s']:.1f} s" for a in result.alarms) or "none"
     fig.suptitle(f"Airspeed monitor: {result.source} — alarms: {kinds}", fontsize=12)
     if path is not None:
-        fig.savefig(path, dpi=110)
+        from pitotcal.io.atomic import save_figure
+
+        save_figure(fig, path, dpi=110)
     return fig
 
 

@@ -296,7 +296,9 @@ def plot(result, path=None):
     fig.suptitle(f"{result.model} model{air}, {result.n_samples} samples — wind {spd:.1f} ± {spd2:.1f}"
                  f" kt from {frm:.0f}° ± {frm2:.1f}° (2σ){state}", fontsize=13)
     if path is not None:
-        fig.savefig(path, dpi=110)
+        from pitotcal.io.atomic import save_figure
+
+        save_figure(fig, path, dpi=110)
     return fig
 
 

@@ -10,6 +10,7 @@ import numpy as np
 
 from pitotcal.core.scenario import CAS_TOLERANCE_KT
 from pitotcal.core.units import m_to_ft, mps_to_kt
+from pitotcal.io.atomic import save_figure
 
 __all__ = ["calibration_lines", "design_lines", "draw_card", "draw_track_sketch",
            "kias_targets", "turn_text"]
@@ -43,7 +44,7 @@ def draw_card(plan, text, png_path):
         draw_track_sketch(fig.add_axes([0.76, 1 - 2.1 / height, 1.8 / 8.27, 1.8 / height]),
                           plan)
     fig.text(0.04, 1 - 2.65 / height, text, family="monospace", fontsize=8, va="top")
-    fig.savefig(png_path, dpi=110)
+    save_figure(fig, png_path, dpi=110)
 
 
 def draw_track_sketch(ax, plan):

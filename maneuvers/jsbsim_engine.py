@@ -99,13 +99,18 @@ def milspec_setting(turbulence_mps, alt_agl_m):
     return w20, severity, ((1.0 - frac) * low + frac * high) * FT_TO_M
 
 
-def new_fdm(aircraft, dt_s):
-    """A quiet JSBSim instance with `aircraft` loaded (PitotcalError naming the choices)."""
+def new_fdm(aircraft, dt_s, scratch_dir):
+    """A quiet JSBSim instance with `aircraft` loaded (PitotcalError naming the choices).
+
+    The aircraft's own <output> file (c172x: JSBout172B.csv, opened at run_ic whatever
+    disable_output says) goes to `scratch_dir`, never the user's working folder.
+    """
     import jsbsim
 
     jsbsim.FGJSBBase().debug_lvl = 0           # no banner, no per-model chatter
     fdm = jsbsim.FGFDMExec(None)
     fdm.set_debug_level(0)
+    fdm.set_output_path(str(scratch_dir))
     if aircraft not in aircraft_names() or not fdm.load_model(aircraft):
         raise PitotcalError(f"aircraft {aircraft!r} is not one JSBSim ships; e.g. "
                             f"{', '.join(n for n in aircraft_names() if n.startswith('c1'))}",

@@ -2,6 +2,7 @@
 sensor models into the same Flight and Truth as `maneuvers.simulator.simulate`."""
 
 import math
+import tempfile
 
 import numpy as np
 
@@ -67,13 +68,15 @@ def simulate_jsbsim(plan, *, seed=0, aircraft=DEFAULT_AIRCRAFT, center_deg=None,
                       settings.get("center_lon_deg", DEFAULT_CENTER_DEG[1]))
     refs = references(plan, opts.rate_hz)
     steps = max(1, math.ceil(JSBSIM_RATE_HZ * refs.dt_s - 1e-9))
-    fdm = new_fdm(aircraft, refs.dt_s / steps)
     # the ground 300 m below the lowest point of the plan (Milspec wants a height above it),
     # as the own simulator takes the altitude as the height above ground
     alt_agl_m = max(float(np.mean(plan.alt_m)), 300.0)
-    trim = start(fdm, plan, refs, opts, center_deg, alt_agl_m)
-    sigma = set_turbulence(fdm, opts, alt_agl_m, seed)
-    record, path_index = fly(fdm, refs, limits, opts, trim, center_deg, steps)
+    with tempfile.TemporaryDirectory(prefix="pitotcal-jsbsim-") as scratch:
+        fdm = new_fdm(aircraft, refs.dt_s / steps, scratch)
+        trim = start(fdm, plan, refs, opts, center_deg, alt_agl_m)
+        sigma = set_turbulence(fdm, opts, alt_agl_m, seed)
+        record, path_index = fly(fdm, refs, limits, opts, trim, center_deg, steps)
+        del fdm                             # closes its output file before the folder goes
     return _outputs(plan, refs, opts, seed, record, path_index,
                     {"engine": "jsbsim", "aircraft": aircraft, "milspec_sigma_mps": sigma,
                      "center_deg": list(center_deg)}, keep_history)

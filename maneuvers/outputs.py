@@ -21,6 +21,8 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.processes import side_by_side
 from pitotcal.core.scenario import ALT_TOLERANCE_FT, CAS_TOLERANCE_KT
 from pitotcal.core.units import m_to_ft, mps_to_kt
+from pitotcal.io.atomic import atomic_open, save_figure
+from pitotcal.io.jsonfile import json_ready
 from pitotcal.io.plan_csv import write_plan
 from pitotcal.io.resample import hold
 
@@ -171,7 +173,8 @@ def write_pilot_card(plan, png_path=None, txt_path=None, cue_s=15.0):
     text = pilot_card_text(plan, cue_s)
     written = []
     if txt_path is not None:
-        Path(txt_path).write_text(text)
+        with atomic_open(txt_path, "w") as fh:
+            fh.write(text)
         written.append(Path(txt_path))
     if png_path is not None:
         from pitotcal.maneuvers.card import draw_card
@@ -217,10 +220,11 @@ def write_autothrottle_csv(plan, path, rate_hz=None):
     """Write `autothrottle_setpoints` as CSV with the plan settings as `#` comments."""
     sp = autothrottle_setpoints(plan, rate_hz)
     path = Path(path)
-    with path.open("w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         for key in ("profile", "cas_min_kt", "cas_max_kt", "altitude_m", "accel_max_mps2"):
             if key in plan.settings:
-                fh.write(f"# {key}: {json.dumps(plan.settings[key])}\n")
+                value = json.dumps(json_ready(plan.settings[key]), allow_nan=False)
+                fh.write(f"# {key}: {value}\n")
         writer = csv.writer(fh)
         writer.writerow(list(sp))
         for row in zip(*sp.values()):
@@ -290,7 +294,7 @@ def plot_plan(plan, path=None):
     ax_q.set_ylabel("samples at 10 Hz")
     ax_q.set_title("distribution of impact pressure")
     if path is not None:
-        fig.savefig(path, dpi=110)
+        save_figure(fig, path, dpi=110)
     return fig
 
 

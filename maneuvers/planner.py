@@ -21,7 +21,7 @@ import numpy as np
 from pitotcal.maneuvers.ocp import TURNS, ManeuverProblem, PathSolution, turn_radius_m
 from pitotcal.maneuvers.profiles import make_schedule
 
-from pitotcal.core.checks import integer, number, option_dict, positive
+from pitotcal.core.checks import exact, integer, number, option_dict, positive, round_to_limit
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import PROFILES, Plan
@@ -36,6 +36,8 @@ log = logging.getLogger(__name__)
 # IPOPT's time grows a little faster than the node count (measured: 240 nodes 0.2 s, 1,200 6 s,
 # 2,400 19 s, 24,000 more than 5 min); beyond this a plan is refused with the dt_s that works.
 MAX_NODES = 3000
+# Issue 15: the longest maneuver planned, s (4 h).
+MAX_DURATION_S = 14400.0
 # IPOPT's iteration limit: the T-2 plans take 30-80 iterations, a 4000 s plan ~440.
 MAX_ITER = 300
 # IPOPT statuses that say the constraints cannot be met (any other failure proves nothing)
@@ -99,6 +101,10 @@ def _request(profile, cas_min_kt, cas_max_kt, radius_m, altitude_m, duration_s, 
                                   f"airspeed range, {cas_max_kt:g} KCAS", param="cas_min_kt")
     radius_m = positive("radius_m", radius_m)
     duration_s = positive("duration_s", duration_s)
+    if duration_s > MAX_DURATION_S:
+        raise PitotcalError(f"duration_s {exact(duration_s)} must be <= {MAX_DURATION_S:g} s: "
+                            "a calibration maneuver is minutes long, and the simulator records "
+                            "at most 2.8 h at 50 Hz", param="duration_s")
     return _Request(
         profile=_choice("profile", profile, PROFILES), cas_min_kt=cas_min_kt,
         cas_max_kt=cas_max_kt, radius_m=radius_m,
@@ -130,14 +136,19 @@ def _where(schedule):
     return "dwell" if len(schedule.groups) == 2 else "third of the q range"
 
 
+def min_dt_s(duration_s):
+    """The smallest dt_s (3 significant digits) the planner takes for `duration_s`."""
+    return round_to_limit(duration_s / MAX_NODES, lo=True)
+
+
 def _check_node_count(req):
     n_nodes = req.duration_s / req.dt_s
     if n_nodes > MAX_NODES:
         raise PitotcalError(
             f"dt_s {req.dt_s:g} s over a {req.duration_s:g} s maneuver gives {n_nodes:.0f} "
             f"plan nodes; the planner takes at most {MAX_NODES} (about half a minute): use at "
-            f"least {np.ceil(req.duration_s / MAX_NODES * 100) / 100:g} s (the simulator flies "
-            f"between the nodes)", param="dt_s")
+            f"least {exact(min_dt_s(req.duration_s))} s (the simulator flies between the "
+            "nodes)", param="dt_s")
     if n_nodes > 1000:
         log.warning("planning %.0f nodes: this takes %.0f-%.0f s", n_nodes,
                     n_nodes / 250, n_nodes / 120)

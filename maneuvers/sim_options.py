@@ -5,23 +5,54 @@ command line its flag); the mean wind defaults to the plan's settings; the recor
 checked against MAX_SAMPLES and the GPS latency against the plan's length.
 """
 
-import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from pitotcal.core.airdata import AIR_DATA_MODES
-from pitotcal.core.checks import choice, number, positive
+from pitotcal.core.checks import choice, exact, number, round_to_limit
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model
 from pitotcal.core.plan import Plan
 from pitotcal.core.scenario import T2_PLAN, true_k
 
-__all__ = ["MAX_SAMPLES", "AirSensors", "SimOptions", "air_sensors", "check_plan", "sim_options"]
+__all__ = ["MAX_SAMPLES", "MIN_SAMPLES", "SIM_LIMITS", "AirSensors", "SimOptions", "air_sensors",
+           "check_plan", "sim_options"]
 
 # Memory grows with the samples (~1.5 kB each in the scalar loop, measured: 1.5 GB peak and
 # 13 s for 10^6): 500,000 is 2.8 h at 50 Hz, or 42 min at 200 Hz.
 MAX_SAMPLES = 500_000
+MIN_SAMPLES = 10          # the flight CSV reader's MIN_ROWS: fewer is no flight
+
+# Issue 15: upper bounds of the options, with the reason given when one is refused (the
+# simulator would run, overflow or fill memory beyond them; nothing real lies there).
+# rate_hz is bounded by MAX_SAMPLES over the plan, gps_latency_s by the plan's length.
+SIM_LIMITS = {
+    "wind_speed_mps": (50.0, "nobody flies a calibration in a wind above 97 kt"),
+    "wind_drift_mps2": (0.1, "6 m/s a minute is a gust front, not a drift"),
+    "turbulence_mps": (10.0, "MIL-F-8785C's severe turbulence is 3-7 m/s RMS"),
+    "turbulence_length_m": (10000.0, "MIL-F-8785C's longest scale length is 533 m"),
+    "qc_noise_pa": (100.0, "100 Pa RMS is 4 kt at 70 kt: no airspeed sensor"),
+    "qc_quantization_pa": (100.0, "100 Pa steps are 4 kt at 70 kt: no airspeed sensor"),
+    "qc_bias_pa": (1000.0, "a 1000 Pa offset is 35 kt at 70 kt: no airspeed sensor"),
+    "qc_scale_error": (0.5, "a gain error beyond 50 % is a broken sensor"),
+    "pneumatic_lag_s": (5.0, "pitot tubing lags 0.01-0.5 s; seconds is a blocked line"),
+    "gps_rate_hz": (100.0, "GNSS receivers update at 1-50 Hz"),
+    "gps_noise_mps": (10.0, "receivers report 0.02-0.5 m/s RMS"),
+}
+
+
+def _limited(name, value, lo=0.0, *, lo_open=False, key=None):
+    """`checks.number` with the `SIM_LIMITS` bound (on |value| when `lo` is None), the reason
+    added to the message."""
+    hi, why = SIM_LIMITS[key or name]
+    try:
+        return number(name, value, -hi if lo is None else lo, hi, lo_open=lo_open)
+    except PitotcalError as exc:
+        if "<=" in str(exc):
+            raise PitotcalError(f"{exc} ({why})", param=name) from None
+        raise
+
 
 _PLAN_COLUMNS_FLOWN = ("north_m", "east_m", "alt_m", "heading_deg", "bank_deg", "tas_mps",
                        "cas_mps")
@@ -131,6 +162,47 @@ def check_plan(plan):
         raise PitotcalError("plan airspeeds must be > 0")
 
 
+# Issue 15: the largest pressure error simulated, |dp/q_c| (beyond it the sensor would read
+# zero or negative impact pressure: no pitot-static system).
+MAX_PRESSURE_ERROR = 0.5
+
+
+def _check_pressure_error(opts, plan):
+    """The true coefficients keep |dp/q_c| <= MAX_PRESSURE_ERROR over the plan's q_c."""
+    model = get_model(opts.model)
+    qc = np.asarray(plan.qc_pa, dtype=float)
+    qc = qc[np.isfinite(qc) & (qc > 0)]
+    with np.errstate(all="ignore"):
+        ratio = np.asarray(model(opts.k, qc), dtype=float)
+    worst = float(np.max(np.abs(ratio))) if ratio.size else 0.0
+    if not worst <= MAX_PRESSURE_ERROR:
+        names = ", ".join(f"{n} {v:g}" for n, v in zip(model.params, opts.k))
+        raise PitotcalError(
+            f"{names}: the {model.name} pressure error dp/qc reaches {worst:.3g} on the "
+            f"plan's q_c {qc.min():.0f}-{qc.max():.0f} Pa; at most {MAX_PRESSURE_ERROR:g} "
+            "(beyond it the sensor reads no impact pressure)", param=model.params[0],
+            mentions=model.params[1:])
+
+
+def _check_samples(rate_hz, span_s):
+    """At least `MIN_SAMPLES` and at most `MAX_SAMPLES` over the plan; the rate suggested is
+    computed from those limits and passes them."""
+    samples = span_s * rate_hz + 1
+    if MIN_SAMPLES <= samples <= MAX_SAMPLES:
+        return
+    lo = round_to_limit((MIN_SAMPLES - 1) / span_s, lo=True)
+    hi = (MAX_SAMPLES - 1) / span_s
+    hi = float(np.floor(hi)) if hi >= 100 else round_to_limit(hi, lo=False)
+    if samples > MAX_SAMPLES:
+        raise PitotcalError(
+            f"rate_hz {exact(rate_hz)} gives {samples:.3g} samples over the plan's {span_s:g} "
+            f"s; the simulator records at most {MAX_SAMPLES:,}: use at most {exact(hi)} Hz",
+            param="rate_hz")
+    raise PitotcalError(
+        f"rate_hz {exact(rate_hz)} gives {samples:.3g} samples over the plan's {span_s:g} s; "
+        f"a flight needs at least {MIN_SAMPLES}: use at least {exact(lo)} Hz", param="rate_hz")
+
+
 def _true_k(model, k):
     pe_model = get_model(model)
     if k is None:
@@ -161,32 +233,30 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
                             param="wind_drift_mps2")
     opts = SimOptions(
         model=model, k=_true_k(model, k),
-        wind_speed_mps=number("wind_speed_mps", wind_speed_mps, 0.0),
+        wind_speed_mps=_limited("wind_speed_mps", wind_speed_mps),
         wind_from_deg=number("wind_from_deg", wind_from_deg, 0.0, 360.0, hi_open=True),
         # each component named like its command-line flag
-        wind_drift_mps2=tuple(number(f"wind_drift_{axis}_mps2", v)
+        wind_drift_mps2=tuple(_limited(f"wind_drift_{axis}_mps2", v, None,
+                                       key="wind_drift_mps2")
                               for axis, v in zip("ne", wind_drift_mps2)),
-        turbulence_mps=number("turbulence_mps", turbulence_mps, 0.0),
+        turbulence_mps=_limited("turbulence_mps", turbulence_mps),
         turbulence_length_m=(None if turbulence_length_m is None
-                             else positive("turbulence_length_m", turbulence_length_m)),
-        rate_hz=positive("rate_hz", rate_hz),
-        qc_noise_pa=number("qc_noise_pa", qc_noise_pa, 0.0),
-        qc_quantization_pa=number("qc_quantization_pa", qc_quantization_pa, 0.0),
-        qc_bias_pa=number("qc_bias_pa", qc_bias_pa),
-        qc_scale_error=number("qc_scale_error", qc_scale_error, -0.5),
-        pneumatic_lag_s=number("pneumatic_lag_s", pneumatic_lag_s, 0.0),
-        gps_rate_hz=number("gps_rate_hz", gps_rate_hz or 0.0, 0.0),
-        gps_noise_mps=number("gps_noise_mps", gps_noise_mps, 0.0),
-        gps_latency_s=number("gps_latency_s", gps_latency_s, 0.0),
+                             else _limited("turbulence_length_m", turbulence_length_m,
+                                           lo_open=True)),
+        rate_hz=number("rate_hz", rate_hz, 0.0, lo_open=True),   # bounded by MAX_SAMPLES
+        qc_noise_pa=_limited("qc_noise_pa", qc_noise_pa),
+        qc_quantization_pa=_limited("qc_quantization_pa", qc_quantization_pa),
+        qc_bias_pa=_limited("qc_bias_pa", qc_bias_pa, None),
+        qc_scale_error=_limited("qc_scale_error", qc_scale_error, -0.5),
+        pneumatic_lag_s=_limited("pneumatic_lag_s", pneumatic_lag_s),
+        gps_rate_hz=_limited("gps_rate_hz", gps_rate_hz or 0.0),
+        gps_noise_mps=_limited("gps_noise_mps", gps_noise_mps),
+        gps_latency_s=number("gps_latency_s", gps_latency_s, 0.0),   # bounded by the plan
         air_data=choice("air_data", air_data, AIR_DATA_MODES),
         air_sensors=_checked_air_sensors(sensors))
     span_s = float(plan.time_s[-1] - plan.time_s[0])
-    samples = span_s * opts.rate_hz + 1
-    if samples > MAX_SAMPLES:
-        raise PitotcalError(
-            f"rate_hz {opts.rate_hz:g} gives {samples:.3g} samples over the plan's {span_s:g} s; "
-            f"the simulator records at most {MAX_SAMPLES:,}: use at most "
-            f"{math.floor((MAX_SAMPLES - 1) / span_s):g} Hz", param="rate_hz")
+    _check_samples(opts.rate_hz, span_s)
+    _check_pressure_error(opts, plan)
     if opts.gps_latency_s >= span_s:
         raise PitotcalError(f"gps_latency_s {opts.gps_latency_s:g} must be shorter than the "
                             f"plan's {span_s:g} s (typical receivers: 0-0.5 s)",

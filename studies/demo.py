@@ -15,6 +15,7 @@ import numpy as np
 
 from pitotcal.core.checks import positive
 from pitotcal.core.scenario import T2_PLAN, TRUE_K
+from pitotcal.io.atomic import atomic_open
 from pitotcal.io.jsonfile import write_json
 
 from .common import truth_delta_v_kt
@@ -160,7 +161,8 @@ def _report(result, flight, files, out):
                            inputs=[("Result JSON", files["result_json"]),
                                    ("Flight", files["flight_csv"])])
     path = out / "report.html"
-    path.write_text(render_html(context), encoding="utf-8")
+    with atomic_open(path, "w", encoding="utf-8") as fh:
+        fh.write(render_html(context))
     return path
 
 

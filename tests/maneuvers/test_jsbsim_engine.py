@@ -117,3 +117,10 @@ def test_a_jsbsim_flight_is_calibrated_within_3_sigma():
         true = truth.parameters[name]
         err = (value - true + 180.0) % 360.0 - 180.0 if name == "wind_from_deg" else value - true
         assert abs(err) < 3.0 * std, (name, value, true, std)
+
+
+def test_jsbsims_own_output_file_never_lands_in_the_working_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    simulate_jsbsim(circle_plan(duration_s=20.0, cas_kt=(80.0, 85.0), radius_m=800.0),
+                    turbulence_mps=0.0, rate_hz=5.0)
+    assert list(tmp_path.iterdir()) == []

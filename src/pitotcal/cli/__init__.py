@@ -21,8 +21,26 @@ COMMANDS = ("demo", "plan", "simulate", "identify", "convert", "study", "legs", 
             "monitor")
 
 
+_NEGATIVE_NUMBER = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+
+
+class _Parser(argparse.ArgumentParser):
+    """An option value argparse refuses (``--runs abc``, ``--engine xyz``, a missing argument)
+    is one line naming the flag, exit status 2, like our own errors: not the usage block.
+    Subcommand parsers are of this class too (argparse makes them of their parent's)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # `--k2 -1e6` is a value, not an option (argparse before 3.13 knows only -1 and -1.5)
+        if hasattr(self, "_negative_number_matcher"):
+            self._negative_number_matcher = _NEGATIVE_NUMBER
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: {message} (see {self.prog} --help)\n")
+
+
 def build_parser():
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="pitotcal",
         description="In-flight GPS calibration of pitot-static systems: plan the maneuver, "
                     "simulate it, identify the pressure error and the wind with honest bounds.")

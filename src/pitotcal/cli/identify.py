@@ -127,13 +127,14 @@ def run(args):
         return _run_live(args)
     import warnings
 
-    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
     from pitotcal.core.checks import choice, number
+    from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
     from pitotcal.core.moist_air import with_static_air
     from pitotcal.estimation import identify
     from pitotcal.estimation.budget import uncertainty_budget
-    from pitotcal.estimation.budget_report import budget_summary, plot_budget_band
+    from pitotcal.estimation.budget_report import budget_summary
     from pitotcal.io import is_log_file, read_flight
 
     choice("model", args.model, [*MODELS, "auto"])
@@ -145,6 +146,10 @@ def run(args):
     for option, out in (("--json", args.json), ("--plot", args.plot), ("--params", args.params)):
         if out is not None:
             check_output(option, out, source, "flight file")
+    # matplotlib would append ".png" to a figure name without extension: write that name
+    plot_path = None if args.plot is None else \
+        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+    check_distinct({"--json": args.json, "--plot": plot_path, "--params": args.params})
     if args.plot is not None:
         _check_plot_format(args.plot)
 
@@ -161,13 +166,25 @@ def run(args):
         flight, autopilot, current = read_flight_and_parameters(
             source, args.start_s, args.end_s, oat_k=oat_k_from_c(args.oat_c))
         if autopilot is None:
-            from pitotcal.core.errors import PitotcalError
             raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
                                 "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
     flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
     result = identify(flight, model=args.model, air=args.air,
                       gps_noise_std_mps=args.gps_noise_mps)
     budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
+
+    # issue 15: every file is written before anything is printed, so a reader that goes
+    # away early (`| head`) never costs a file
+    if args.json is not None:
+        _write_json(args.json, result, flight, source, budget)
+    if plot_path is not None:
+        _write_plot(plot_path, result, budget)
+    params, refused = None, None
+    if args.params is not None:
+        try:
+            params = _write_params(args, flight, autopilot, current)
+        except PitotcalError as exc:        # said after the summary, as before
+            refused = exc
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
@@ -179,21 +196,27 @@ def run(args):
         warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "
                       "are not a calibration", stacklevel=2)
     if args.json is not None:
-        _write_json(args.json, result, flight, source, budget)
         print(f"\nWrote {args.json}")
-    if args.plot is not None:
-        # matplotlib writes PNG and appends ".png" to a name without extension: say so
-        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-        if budget is None:
-            result.plot(plot_path)
-        else:
-            fig = result.plot()
-            plot_budget_band(fig.axes[0], result, budget)      # the ΔV axes
-            fig.savefig(plot_path, dpi=110)
+    if plot_path is not None:
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
-    if args.params is not None:
-        _write_params(args, flight, autopilot, current)
+    if refused is not None:
+        raise refused
+    if params is not None:
+        _print_params(params, args.params)
     return 0
+
+
+def _write_plot(path, result, budget):
+    """The calibration figure, with the expanded-uncertainty band when there is a budget."""
+    if budget is None:
+        result.plot(path)
+        return
+    from pitotcal.estimation.budget_report import plot_budget_band
+    from pitotcal.io.atomic import save_figure
+
+    fig = result.plot()
+    plot_budget_band(fig.axes[0], result, budget)      # the ΔV axes
+    save_figure(fig, path, dpi=110)
 
 
 def _write_params(args, flight, autopilot, current):
@@ -205,9 +228,13 @@ def _write_params(args, flight, autopilot, current):
     rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
                     gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air)
     write_parameter_file(rec, args.params)
+    return rec
+
+
+def _print_params(rec, path):
     print(f"\nRecommended {rec.name} = {rec.value:.4f} ± {rec.two_sigma:.4f} (2σ)"
           + ("" if rec.current is None else f", now {rec.current:.6g}")
-          + f"; wrote {args.params}")
+          + f"; wrote {path}")
     for note in rec.notes:
         print(f"  note: {note}")
 

@@ -75,6 +75,13 @@ def _series_options(args):
     return {k: v for k, v in opts.items() if v is not None}
 
 
+def _plot_path(args):
+    """--plot as written: a name without extension gets ".png" (matplotlib's default)."""
+    if args.plot is None:
+        return None
+    return args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+
+
 def run(args):
     from pitotcal.cli.common import check_distinct, check_output
     from pitotcal.core.checks import choice
@@ -91,7 +98,8 @@ def run(args):
     for option, out in outputs.items():
         if out is not None:
             check_output(option, out, source, "flight file" if flight else "leg file")
-    check_distinct(outputs)
+    # matplotlib would append ".png" to a figure name without extension: that name counts
+    check_distinct({**outputs, "--plot": _plot_path(args)})
     if flight:
         return _run_flight(args, source)
     given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out")
@@ -107,15 +115,18 @@ def _run_legs(args, source):
     from pitotcal.io.jsonfile import write_json
     from pitotcal.io.legs_csv import read_legs
 
+    plot_path = _plot_path(args)
     legs = read_legs(source)
     points, fit, notes = analyze_legs(legs, model=args.model, wind=args.wind)
-    print(legs_summary(legs, points, fit, notes))
+    # files first, then the summary: a reader that goes away early never costs a file
     if args.json is not None:
         write_json(args.json, legs_json(legs, points, fit, notes))
-        print(f"\nWrote {args.json}")
-    if args.plot is not None:
-        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+    if plot_path is not None:
         plot_legs(points, fit, plot_path)
+    print(legs_summary(legs, points, fit, notes))
+    if args.json is not None:
+        print(f"\nWrote {args.json}")
+    if plot_path is not None:
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
     return 0
 
@@ -153,9 +164,7 @@ def _run_flight(args, source):
     flight = read_flight(source)
     res = analyze_leg_flight(flight, windows, model=args.model, wind=args.wind,
                              point_tol_kt=tol, **detect)
-    print(legs_summary(res["legs"], res["points"], res["fit"], res["notes"]))
-    print("\n" + flight_legs_text(res))
-    wrote = []
+    wrote = []          # files first, then the summary: a reader that goes away early
     if args.legs_out is not None:
         write_legs(res["legs"], args.legs_out,
                    comments=[f"legs found in {source} by pitotcal legs"])
@@ -164,9 +173,10 @@ def _run_flight(args, source):
         write_json(args.json, flight_legs_json(res, source))
         wrote.append(args.json)
     if args.plot is not None:
-        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-        plot_legs(res["points"], res["fit"], plot_path, series=res["series"])
-        wrote.append(plot_path)
+        plot_legs(res["points"], res["fit"], _plot_path(args), series=res["series"])
+        wrote.append(_plot_path(args))
+    print(legs_summary(res["legs"], res["points"], res["fit"], res["notes"]))
+    print("\n" + flight_legs_text(res))
     if wrote:
         print("\n" + "\n".join(f"Wrote {w}" for w in wrote))
     return 0

@@ -65,7 +65,7 @@ def run(args):
     import sys
     import warnings
 
-    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
     from pitotcal.core.checks import positive
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor import monitor
@@ -78,6 +78,10 @@ def run(args):
     for option, out in (("--json", args.json), ("--plot", args.plot)):
         if out is not None:
             check_output(option, out, source, "flight file")
+    # matplotlib would append ".png" to a figure name without extension: that name counts
+    plot_path = None if args.plot is None else \
+        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+    check_distinct({"--json": args.json, "--plot": plot_path, "--calibration": None})
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
                           warmup_s=args.warmup_s).checked()
@@ -92,19 +96,20 @@ def run(args):
         result = monitor(flight, cal, opts)
     for message in result.warnings:
         warnings.warn(message, stacklevel=2)
+    out = result.to_dict()
+    out["warnings"] = list(out["warnings"]) + [w for w in flight.warnings
+                                               if w not in out["warnings"]]
+    # files first, then the summary: a reader that goes away early never costs a file
+    if args.json is not None:
+        write_json(args.json, out)
+    if plot_path is not None:
+        result.plot(plot_path)
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s); calibration {args.calibration} ({cal.model}, "
           f"{cal.air_data})")
     print(result.summary())
-    out = result.to_dict()
-    out["warnings"] = list(out["warnings"]) + [w for w in flight.warnings
-                                               if w not in out["warnings"]]
-    if args.json is not None:
-        write_json(args.json, out)
-        print(f"Wrote {args.json}")
-    if args.plot is not None:
-        plot_path = args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-        result.plot(plot_path)
-        print(f"Wrote {plot_path}")
+    for path in (args.json, plot_path):
+        if path is not None:
+            print(f"Wrote {path}")
     print(json.dumps({"alarms": out["alarms"]}))
     return 1 if result.alarms else 0

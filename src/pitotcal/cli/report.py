@@ -45,7 +45,7 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
     from pitotcal.core.checks import choice
     from pitotcal.estimation.calibration_report import make_report
 
@@ -54,6 +54,11 @@ def run(args):
     for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
         if out is not None:
             check_output(option, out, source, "result JSON")
+    check_distinct({"-o": args.output, "--json": args.json, "--pdf": args.pdf})
+    if args.flight is not None:     # the flight is an input too: never written over
+        for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
+            if out is not None:
+                check_output(option, out, args.flight, "flight")
     options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
     read = {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c)}
     done = make_report(source, args.output, flight_path=args.flight, flight_options=read,

@@ -71,9 +71,12 @@ def run(args):
 def _repeat(args, rerun):
     import json
 
+    from pitotcal.io.jsonfile import json_ready
+
     rows = rerun(args.name, args.run_index, runs=args.runs, seed=args.seed, quick=args.quick,
                  data_dir=args.data_dir, engine=args.engine)
-    print(json.dumps(rows, indent=2, default=str))
+    # strict JSON (NaN as null) that any parser reads; what json cannot hold as text
+    print(json.dumps(json_ready(rows), indent=2, default=str, allow_nan=False))
     return 1 if any(r.get("error") for r in rows) else 0
 
 

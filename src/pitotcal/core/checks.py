@@ -10,7 +10,8 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError
 
-__all__ = ["choice", "integer", "number", "option_dict", "positive", "wrap_deg"]
+__all__ = ["choice", "exact", "integer", "number", "option_dict", "positive", "round_to_limit",
+           "wrap_deg"]
 
 
 def number(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False):
@@ -28,11 +29,33 @@ def number(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=Fal
     if below or above:
         rules = []
         if math.isfinite(lo):
-            rules.append(f"{'>' if lo_open else '>='} {lo:g}")
+            rules.append(f"{'>' if lo_open else '>='} {exact(lo)}")
         if math.isfinite(hi):
-            rules.append(f"{'<' if hi_open else '<='} {hi:g}")
-        raise PitotcalError(f"{name} {x:g} must be {' and '.join(rules)}", param=name)
+            rules.append(f"{'<' if hi_open else '<='} {exact(hi)}")
+        raise PitotcalError(f"{name} {exact(x)} must be {' and '.join(rules)}", param=name)
     return x
+
+
+def exact(x):
+    """`x` as short text that still tells it from its neighbours: ``{:g}`` when that reads
+    back as `x`, else up to 12 significant digits (a limit of 333333.33 is never shown as the
+    333333 it refuses)."""
+    text = f"{x:g}"
+    return text if float(text) == x else f"{x:.12g}"
+
+
+def round_to_limit(x, lo=True, digits=3):
+    """`x` rounded to `digits` significant digits away from the forbidden side: up for a
+    lower limit (`lo`), down for an upper one, so a suggested value always passes."""
+    if x == 0 or not math.isfinite(x):
+        return x
+    step = 10.0 ** (math.floor(math.log10(abs(x))) - digits + 1)
+    k = (math.ceil if lo else math.floor)(x / step)
+    while True:             # the text of the value, read back, is on the allowed side
+        value = float(f"{k * step:.{digits + 1}g}")
+        if (value >= x) if lo else (value <= x):
+            return value
+        k += 1 if lo else -1
 
 
 def positive(name, value):

@@ -13,8 +13,8 @@ from pitotcal.core import checks
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 
-__all__ = ["MAX_BAD_FRACTION", "QCI_MIN_FLYING_PA", "check_units", "check_window",
-           "drop_bad_rows"]
+__all__ = ["MAX_BAD_FRACTION", "PLAUSIBLE", "QCI_MIN_FLYING_PA", "check_plausible", "check_time_units",
+           "check_units", "check_vertical_speed", "check_window", "drop_bad_rows", "looks_utf16"]
 
 MAX_BAD_FRACTION = 0.01      # more unusable rows than this is a bad column, not a glitch
 QCI_MIN_FLYING_PA = 20.0     # 0.5 * 1.225 * (11 kt)^2: nothing that flies is slower
@@ -22,6 +22,15 @@ QCI_MIN_FLYING_PA = 20.0     # 0.5 * 1.225 * (11 kt)^2: nothing that flies is sl
 # `Flight.alt_m`, not a reason to drop the row or reject the file.
 INFORMATIVE = ("alt_m",)
 _POSITIVE = ("qc_pa", "rho_kgm3", "ps_pa", "oat_k", "ps_ref_pa")
+# Issue 15: a cell outside these bounds is no measurement of a flying aircraft (a logger
+# glitch, a corrupt cell): unusable like NaN. GNSS receivers stop reporting velocity above
+# 515 m/s (the COCOM limit, 1000 kt); 2e5 Pa is the impact pressure of Mach 1.6 at sea level;
+# 2.5 kg/m^3 and 1.2e5 Pa are beyond any air at any airfield (ISA -90 degC at 1.08 bar is
+# 2.05 kg/m^3); 400 K is 127 degC.
+PLAUSIBLE = {"qc_pa": (0.0, 2e5), "gps_vn_mps": (-515.0, 515.0),
+             "gps_ve_mps": (-515.0, 515.0), "gps_vd_mps": (-515.0, 515.0),
+             "rho_kgm3": (0.0, 2.5), "ps_pa": (0.0, 1.2e5), "ps_ref_pa": (0.0, 1.2e5),
+             "oat_k": (0.0, 400.0), "alt_m": (-1000.0, 1e5)}
 
 # Unit diagnosis (see the flight_csv module docstring). q_ci / (0.5 rho |V_g|^2) of a flying
 # aircraft is 1 / (1 + (W/V)^2) on a full circle and at worst (1 -/+ W/V)^-2 on one leg:
@@ -69,7 +78,44 @@ def _row_problem(table, data_row, r, use):
             return c, f"q_ci = {v:g} Pa is not positive"
         if c in _POSITIVE and v <= 0:
             return c, f"{v:g} is not positive"
+        if c in PLAUSIBLE and not _plausible(c, v):
+            lo, hi = PLAUSIBLE[c]
+            return c, f"{v:g} is outside the plausible {lo:g} to {hi:g}"
     return None
+
+
+def _glitches(data, use):
+    """Rows with an implausible cell in a column where such cells are glitches (at most
+    `MAX_BAD_FRACTION` of the rows); more is a unit or a column problem, said by the unit
+    checks or `check_plausible`."""
+    out = np.zeros(data.shape[0], dtype=bool)
+    for j, c in enumerate(use):
+        if c in PLAUSIBLE and c not in INFORMATIVE:
+            off = np.isfinite(data[:, j]) & ~_plausible(c, data[:, j])
+            if off.sum() <= MAX_BAD_FRACTION * data.shape[0]:
+                out |= off
+    return out
+
+
+def check_plausible(name, table, data, rows, use):
+    """Refuse a file with cells outside `PLAUSIBLE` left after the unit checks, naming the
+    first (column, row, value) and how many."""
+    for j, c in enumerate(use):
+        if c in PLAUSIBLE and c not in INFORMATIVE:
+            off = np.flatnonzero(~_plausible(c, data[:, j]))
+            if off.size:
+                lo, hi = PLAUSIBLE[c]
+                r = int(off[0])
+                raise FlightDataError(f"{name}: column {c}, {table.where(rows[r])}: "
+                                      f"{data[r, j]:g} is outside the plausible {lo:g} to {hi:g} "
+                                      f"({off.size} of {data.shape[0]} rows)")
+
+
+def _plausible(column, value):
+    """True (elementwise) where `value` is inside the column's `PLAUSIBLE` range."""
+    lo, hi = PLAUSIBLE.get(column, (-np.inf, np.inf))
+    with np.errstate(invalid="ignore"):
+        return (value >= lo) & (value <= hi)
 
 
 def _bad_rows(table, data, rows, use):
@@ -80,6 +126,7 @@ def _bad_rows(table, data, rows, use):
     for c in _POSITIVE:
         if c in col:
             bad |= data[:, col[c]] <= 0
+    bad |= _glitches(data, use)
     if table.bad:
         # a row whose first problem is in an informative column has no problem elsewhere
         # (cells are checked in `use` order, informative columns last)
@@ -87,7 +134,7 @@ def _bad_rows(table, data, rows, use):
     for c in INFORMATIVE:
         if c in col:            # informative only: a bad cell is NaN there, the row stays
             v = data[:, col[c]]
-            data[:, col[c]] = np.where(np.isfinite(v), v, np.nan)
+            data[:, col[c]] = np.where(np.isfinite(v) & _plausible(c, v), v, np.nan)
     return bad
 
 
@@ -205,3 +252,118 @@ def check_units(name, qci, vn, ve, rho):
         f"{name}: columns qc_pa and gps_vn_mps/gps_ve_mps disagree: median q_ci {q_med:.4g} Pa "
         f"implies {implied:.3g} m/s true airspeed but the median ground speed is {gs_med:.3g} "
         "m/s; check their units")
+
+
+# Issue 15: the time column's unit. A calibration flight is sampled at 0.5-1000 Hz: a median
+# step above 2 "s" is a log in milliseconds or microseconds; a first time after 1e8 s (1973)
+# is a clock (Unix time), not seconds since the log started.
+_TIME_STEP_MAX_S = 2.0
+_UNIX_TIME_MIN_S = 1e8
+
+
+def check_time_units(name, t):
+    """Refuse a time column in ms or µs (naming the unit and the rate it implies); return a
+    warning text for Unix time in seconds (used as it is: only time differences matter), or
+    None."""
+    step = float(np.median(np.diff(t)))
+    if step > _TIME_STEP_MAX_S:
+        for unit, scale in (("milliseconds", 1e3), ("microseconds", 1e6)):
+            if step / scale <= _TIME_STEP_MAX_S:
+                clock = " (Unix time)" if t[0] / scale >= _UNIX_TIME_MIN_S else ""
+                raise FlightDataError(
+                    f"{name}: column time_s: median step {step:.6g} looks like {unit}"
+                    f"{clock} ({scale / step:.3g} Hz); expected seconds (time_s = value / "
+                    f"{scale:g})")
+        raise FlightDataError(f"{name}: column time_s: median step {step:.6g} s between samples; "
+                              f"a flight is sampled at least every {_TIME_STEP_MAX_S:g} s")
+    if t[0] >= _UNIX_TIME_MIN_S:
+        import datetime
+
+        start = datetime.datetime.fromtimestamp(float(t[0]), datetime.UTC)
+        text = (f"{name}: column time_s looks like Unix time in seconds (starts "
+                f"{start:%Y-%m-%d %H:%M:%S} UTC); used as seconds (only differences matter)")
+        warnings.warn(text, stacklevel=3)
+        return text
+    return None
+
+
+# A calibration is flown near level: the median |vertical speed| of a flight is a few percent
+# of its ground speed. More than a quarter (a 14 deg median flight path) is another unit.
+_VD_RATIO_MAX = 0.25
+
+
+def check_vertical_speed(name, vd, vn, ve, t=None, alt=None):
+    """Refuse `gps_vd_mps` in cm/s (or in another unit, or not a vertical speed).
+
+    Two tests: its median magnitude against the ground speed, and, with `alt_m`, the
+    altitude change against the integrated vertical speed (1 in m/s, 0.01 in cm/s).
+    """
+    gs = float(np.median(np.hypot(vn, ve)))
+    vd_med = float(np.median(np.abs(vd)))
+    slope = _altitude_slope(vd, t, alt)
+    if vd_med <= _VD_RATIO_MAX * gs and (slope is None or 0.3 <= slope <= 3.0):
+        return
+    if slope is not None and 0.003 <= slope <= 0.03 or \
+            slope is None and vd_med / 100.0 <= _VD_RATIO_MAX * gs:
+        how = (f"the altitude changes {slope:.3g} m per unit of its integral"
+               if slope is not None else f"median |vd| {vd_med:.4g} against a median ground "
+                                         f"speed {gs:.4g} m/s")
+        raise FlightDataError(f"{name}: column gps_vd_mps looks like cm/s ({how}); expected "
+                              "m/s, positive down")
+    raise FlightDataError(f"{name}: column gps_vd_mps: median |vd| {vd_med:.4g} against a median "
+                          f"ground speed {gs:.4g} m/s is not the vertical speed of a calibration "
+                          "flight in m/s, positive down")
+
+
+def _altitude_slope(vd, t, alt):
+    """Altitude change per metre of integrated -vd (least squares), or None when the flight
+    has no alt_m or too little vertical motion (< 20 m either way) to say."""
+    if t is None or alt is None:
+        return None
+    ok = np.isfinite(alt)
+    if ok.sum() < 10:
+        return None
+    climb = -np.concatenate([[0.0], np.cumsum(0.5 * (vd[1:] + vd[:-1]) * np.diff(t))])
+    x, y = climb[ok] - climb[ok].mean(), alt[ok] - alt[ok].mean()
+    if np.ptp(y) < 20.0 and np.ptp(x) < 20.0:
+        return None
+    if x @ x == 0:          # a column of zeros: a logger without vertical speed
+        return None
+    slope = float(x @ y / (x @ x))
+    return slope if np.corrcoef(x, y)[0, 1] ** 2 > 0.8 else None
+
+
+def looks_utf16(head):
+    """True when the bytes `head` are UTF-16 text (a byte-order mark, or ASCII with every
+    other byte zero: what Windows tools write as "Unicode")."""
+    if head[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        return True
+    even, odd = head[0:2000:2], head[1:2000:2]
+    for text, zeros in ((even, odd), (odd, even)):
+        if zeros and zeros.count(0) > 0.9 * len(zeros) and \
+                sum(32 <= b < 127 or b in (9, 10, 13) for b in text) > 0.9 * len(text):
+            return True
+    return False
+
+
+def implausible_samples(name, t, **columns):
+    """Mask of the samples with a finite value outside `PLAUSIBLE` in any of `columns`
+    ({column name: array}; None skipped), and the warning naming the first one (or None)."""
+    mask = np.zeros(t.size, dtype=bool)
+    first = None
+    for c, v in columns.items():
+        if v is None:
+            continue
+        v = np.asarray(v, dtype=float)
+        off = np.isfinite(v) & ~_plausible(c, v)
+        if off.any() and (first is None or np.argmax(off) < first[0]):
+            first = (int(np.argmax(off)), c, float(v[np.argmax(off)]))
+        mask |= off
+    if first is None:
+        return mask, None
+    i, c, value = first
+    lo, hi = PLAUSIBLE[c]
+    text = (f"{name}: cut {int(mask.sum())} samples with implausible values (first: {c} "
+            f"{value:g} at {t[i]:.2f} s, outside {lo:g} to {hi:g})")
+    warnings.warn(text, stacklevel=3)
+    return mask, text

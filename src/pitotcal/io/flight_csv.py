@@ -58,13 +58,18 @@ from pitotcal.core.moist_air import with_static_air
 from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import density_kgm3
 
+from .atomic import atomic_open
 from .flight_checks import (
+    check_plausible,
     check_ps_oat,
     check_rho,
     check_time,
+    check_time_units,
     check_units,
+    check_vertical_speed,
     check_window,
     drop_bad_rows,
+    looks_utf16,
     window_text,
 )
 
@@ -87,8 +92,9 @@ def write_flight_csv(flight, path, comments=None):
             data.append(getattr(flight, name))
     meta = {**flight.meta, **(comments or {})}
     header = "".join(f"# {key}: {value}\n" for key, value in meta.items()) + ",".join(columns)
-    np.savetxt(path, np.column_stack(data), delimiter=",", header=header, comments="",
-               fmt=["%.4f"] + ["%.9g"] * (len(columns) - 1))
+    with atomic_open(path, "w") as fh:          # whole or not at all: never a spliced file
+        np.savetxt(fh, np.column_stack(data), delimiter=",", header=header, comments="",
+                   fmt=["%.4f"] + ["%.9g"] * (len(columns) - 1))
     return path
 
 
@@ -150,6 +156,12 @@ def read_flight_csv(path, start_s=None, end_s=None):
             check_ps_oat(name, data[:, col["ps_pa"]], temperature)
         rho = density_kgm3(data[:, col["ps_pa"]], temperature)
     check_units(name, qci, vn, ve, rho)
+    # issue 15: no implausible cell left, the units of time and of the vertical speed
+    check_plausible(name, table, data, rows, use)
+    clock = check_time_units(name, time_s)
+    if "gps_vd_mps" in col:
+        check_vertical_speed(name, data[:, col["gps_vd_mps"]], vn, ve, time_s,
+                             data[:, col["alt_m"]] if "alt_m" in col else None)
     if "ps_ref_pa" in col:
         check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, 288.15), column="ps_ref_pa")
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
@@ -157,7 +169,8 @@ def read_flight_csv(path, start_s=None, end_s=None):
     flight = Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
                     gps_vn_mps=np.ascontiguousarray(vn), gps_ve_mps=np.ascontiguousarray(ve),
                     rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
-                    n_dropped=n_dropped, warnings=(warning,) if warning else (), **optional)
+                    n_dropped=n_dropped, warnings=tuple(w for w in (warning, clock) if w),
+                    **optional)
     return with_static_air(flight)          # issue 9: tat_k, rh_pct (core.moist_air)
 
 
@@ -207,6 +220,8 @@ def _reject_binary(path, name):
             kind = "PX4 ULog file (name it .ulg to read it as a log)"
         elif head[:2] == b"\xa3\x95":
             kind = "ArduPilot DataFlash log (name it .bin to read it as a log)"
+        elif looks_utf16(head):
+            kind = "UTF-16 text (save it as UTF-8: a flight CSV is UTF-8 or ASCII)"
         raise FlightDataError(f"{name}: {kind}, not a flight CSV")
 
 

@@ -29,6 +29,7 @@ import numpy as np
 from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
+from pitotcal.io.atomic import atomic_open
 
 __all__ = ["LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
@@ -171,13 +172,23 @@ def write_legs(legs, path, comments=()):
             w.writerow(row)
 
 
+def _not_text(path):
+    """Why a file that is no UTF-8 is not read: UTF-16 named as such, else binary."""
+    from pitotcal.io.flight_checks import looks_utf16
+
+    with open(path, "rb") as f:
+        head = f.read(4096)
+    return ("UTF-16 text (save it as UTF-8: a CSV here is UTF-8 or ASCII)" if looks_utf16(head)
+            else "not a text CSV (binary data)")
+
+
 def _read_rows(path, name):
     """(header, data rows, file line of each row); comment and blank lines skipped."""
     with open(path, newline="", encoding="utf-8-sig") as f:
         try:
             text = f.read()
         except UnicodeDecodeError:
-            raise FlightDataError(f"{name}: not a text CSV (binary data)") from None
+            raise FlightDataError(f"{name}: {_not_text(path)}") from None
     header, rows, lines = None, [], []
     for number, row in enumerate(csv.reader(text.splitlines()), start=1):
         if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):

@@ -69,7 +69,7 @@ from pitotcal.core.flight import Flight
 from pitotcal.core.units import density_kgm3, isa_pressure_pa, isa_temperature_k, wind_polar
 
 from .airborne import airspeed_gate, flight_state_cuts
-from .flight_checks import QCI_MIN_FLYING_PA, check_window, window_text
+from .flight_checks import QCI_MIN_FLYING_PA, check_window, implausible_samples, window_text
 from .flight_csv import PLAN_NOT_FLIGHT, csv_kind
 from .flightlog import AutopilotWind, FlightLog
 from .streams import LOG_EXTENSIONS
@@ -224,12 +224,16 @@ def _assemble(s, name, start_s, end_s, opt):
             f"q_ci < {opt.min_q:g} Pa": q < opt.min_q}
     cuts.update(slow)
     cuts["non-finite density"] = ~np.isfinite(rho) | (rho <= 0)
+    # issue 15: a logger glitch (1e200 in a GPS velocity) is cut, never fitted
+    cuts["implausible value"], glitch = implausible_samples(
+        name, t, qc_pa=q, gps_vn_mps=gps.vn, gps_ve_mps=gps.ve, rho_kgm3=rho,
+        gps_vd_mps=gps.vd if s.gps_vd is not None else None)
 
     keep, excluded, attributed = apply_cuts(name, t, cuts)
     if n_bad_rows:
         excluded["non-finite or repeated time"] = int(n_bad_rows)
         log.info("%s: dropped %d non-finite or repeated pressure samples", name, n_bad_rows)
-    warned = _warn_all(name, s)
+    warned = _warn_all(name, s) + ((glitch,) if glitch else ())
     _require_enough(name, t, keep, cuts, slow)
 
     wind = _autopilot_wind(s, start_s, end_s)

@@ -99,6 +99,6 @@ def write_qgc_plan(path, home, items, *, cruise_speed_mps, firmware_type=12, veh
         },
     }
     with atomic_open(path, "w", encoding="utf-8") as f:
-        json.dump(plan, f, indent=2)
+        json.dump(plan, f, indent=2, allow_nan=False)     # strict JSON, as QGC parses it
         f.write("\n")
     return path

@@ -15,6 +15,7 @@ CSV written by `pitotcal convert`, from its ``# autopilot_...`` comment lines.
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
+from pitotcal.io.atomic import atomic_open
 
 __all__ = ["QGC_REAL32", "read_flight_and_parameters", "read_qgc_params",
            "write_ardupilot_params", "write_qgc_params"]
@@ -60,7 +61,8 @@ def write_ardupilot_params(path, name, value, comments=()):
     stores float32, ~7 significant digits).
     """
     lines = [f"# {c}" for c in comments] + [f"{name},{value:.6f}"]
-    Path(path).write_text("\n".join(lines) + "\n")
+    with atomic_open(path, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
     return path
 
 
@@ -70,7 +72,8 @@ def write_qgc_params(path, name, value, comments=(), vehicle_id=1, component_id=
               *(f"# {c}" for c in comments), "#",
               "# Vehicle-Id Component-Id Name Value Type"]
     row = f"{vehicle_id}\t{component_id}\t{name}\t{value:.6f}\t{QGC_REAL32}"
-    Path(path).write_text("\n".join(header + [row]) + "\n")
+    with atomic_open(path, "w") as fh:
+        fh.write("\n".join(header + [row]) + "\n")
     return path
 
 

@@ -10,6 +10,8 @@ import numpy as np
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.plan import PLAN_COLUMNS, PLAN_RANGES, Plan
 from pitotcal.io.atomic import atomic_open
+from pitotcal.io.flight_checks import looks_utf16
+from pitotcal.io.jsonfile import json_ready
 
 __all__ = ["read_plan", "write_plan"]
 
@@ -19,7 +21,7 @@ def write_plan(plan, path):
     path = Path(path)
     with atomic_open(path, "w", newline="") as fh:
         for key, value in plan.settings.items():
-            fh.write(f"# {key}: {json.dumps(value)}\n")
+            fh.write(f"# {key}: {json.dumps(json_ready(value), allow_nan=False)}\n")
         writer = csv.writer(fh)
         writer.writerow(PLAN_COLUMNS)
         data = np.column_stack([plan.column(c) for c in PLAN_COLUMNS])
@@ -41,6 +43,9 @@ def read_plan(path):
     try:
         lines = path.read_text(encoding="utf-8-sig").splitlines()
     except (OSError, UnicodeDecodeError) as exc:
+        if isinstance(exc, UnicodeDecodeError) and looks_utf16(path.read_bytes()[:4096]):
+            raise PitotcalError(f"{path}: cannot read plan: UTF-16 text (save it as UTF-8: a "
+                                "plan CSV is UTF-8 or ASCII)") from None
         raise PitotcalError(f"{path}: cannot read plan: {exc}") from None
     for header_row, line in enumerate(lines):
         if not line.startswith("#"):
