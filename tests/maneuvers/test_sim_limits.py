@@ -4,7 +4,8 @@ pass them."""
 
 import numpy as np
 import pytest
-from pitotcal.maneuvers.planner import MAX_DURATION_S, MAX_NODES, min_dt_s, plan_maneuver
+from pitotcal.maneuvers.plan_request import MAX_DURATION_S, MAX_NODES, min_dt_s
+from pitotcal.maneuvers.planner import plan_maneuver
 from pitotcal.maneuvers.sim_options import MAX_SAMPLES, MIN_SAMPLES, SIM_LIMITS, _check_samples
 from pitotcal.maneuvers.simulator import simulate
 from plans import circle_plan
