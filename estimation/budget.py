@@ -18,8 +18,10 @@ The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a coun
 
 - oat: static air temperature, u = 1 K (a calibrated OAT probe ±1 K; the issue's figure); the
   density ρ → ρ T/(T ± u) and the static temperature itself.
-- humidity: relative humidity, u = 5 %RH with a humidity channel or --rh-percent, else 29 %RH
-  (= 50/√3: dry air assumed, the truth anywhere in 0-100 %); ρ through the virtual temperature.
+- humidity: relative humidity, u = 5 %RH with a humidity channel or --rh-percent, else 58 %RH
+  (= 100/√3: dry air assumed while the truth is anywhere in 0-100 %, so the error is one-sided
+  and its RMS is the effect at 100/√3, not the 50/√3 of an estimate centred at 50 %); ρ
+  through the virtual temperature.
 - gps_velocity_bias: a constant GPS velocity error per axis, u = 0.05 m/s (u-blox M8/M9 speed
   accuracy). A horizontal bias b is the wind's: V_g + b − W = V_g − (W − b), so the fitted wind
   absorbs it exactly and ΔV does not move (the tests re-solve to show it); only the vertical
@@ -59,14 +61,14 @@ SOURCES = (
     ("qc_offset", "u_qc_offset_pa", "Pa"),
 )
 RH_U_GIVEN_PCT = 5.0                       # a humidity channel's standard uncertainty
-RH_U_UNKNOWN_PCT = 50.0 / math.sqrt(3.0)   # dry assumed, truth anywhere in 0-100 %RH
+RH_U_UNKNOWN_PCT = 100.0 / math.sqrt(3.0)  # dry assumed, truth anywhere in 0-100 %RH: RMS error
 
 
 @dataclasses.dataclass(frozen=True)
 class BudgetInputs:
     """Standard uncertainties of the Type B inputs (module notes give each default's source).
 
-    `u_rh_pct` None: 5 %RH when the flight has a humidity, else 29 %RH (dry assumed).
+    `u_rh_pct` None: 5 %RH when the flight has a humidity, else 58 %RH (dry assumed).
     """
 
     u_oat_k: float = 1.0

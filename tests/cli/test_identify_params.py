@@ -36,6 +36,26 @@ def test_params_on_top_of_input_refused_before_work(flight, tmp_path, capsys):
     assert "--params" in capsys.readouterr().err
 
 
+def _oat_c(flight):
+    """The (constant) temperature the test logs write, degC, as --oat-c text."""
+    from logwriters import PS_PA
+
+    from pitotcal.core.units import R_AIR_JKGK
+
+    return repr(float(PS_PA / (R_AIR_JKGK * flight.rho_kgm3[0]) - 273.15))
+
+
+def test_a_log_without_outside_air_temperature_is_refused(flight, tmp_path, capsys):
+    from logwriters import write_dataflash_text
+
+    log, out = tmp_path / "f.log", tmp_path / "new.param"
+    write_dataflash_text(log, flight, ratio=2.0)
+    assert main(["identify", str(log), "--params", str(out), "--no-budget"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith("pitotcal identify: --params: ") and "give the OAT with --oat-c" in err
+    assert not out.exists()
+
+
 def test_px4_ulog_end_to_end_qgc_file(flight, tmp_path, capsys):
     """A ULog with the older ASPD_SCALE = 1: the QGC file carries that name and 1/sqrt(1-k1)."""
     from logwriters import write_ulog
@@ -44,9 +64,10 @@ def test_px4_ulog_end_to_end_qgc_file(flight, tmp_path, capsys):
 
     log, out = tmp_path / "f.ulg", tmp_path / "new.params"
     write_ulog(log, flight)
-    # the synthetic flight's truth is q_c = ½ρV² (incompressible): fitted as it was made
+    # the synthetic flight's truth is q_c = ½ρV² (incompressible): fitted as it was made, at
+    # the air temperature the log's sensor carries (a log without OAT is refused, below)
     assert main(["identify", str(log), "--model", "constant", "--air", "incompressible",
-                 "--params", str(out)]) == 0
+                 "--oat-c", _oat_c(flight), "--params", str(out)]) == 0
     params = read_qgc_params(out)
     assert list(params) == ["ASPD_SCALE"]
     assert params["ASPD_SCALE"] == pytest.approx(1.0 / 0.82 ** 0.5, rel=2e-3)
@@ -59,9 +80,10 @@ def test_dataflash_end_to_end_mavproxy_file(flight, tmp_path, capsys):
 
     log, out = tmp_path / "f.log", tmp_path / "new.param"
     write_dataflash_text(log, flight, ratio=2.0)
-    # the synthetic flight's truth is q_c = ½ρV² (incompressible): fitted as it was made
+    # the synthetic flight's truth is q_c = ½ρV² (incompressible): fitted as it was made, at
+    # the air temperature the log's sensor carries (a log without OAT is refused, below)
     assert main(["identify", str(log), "--model", "constant", "--air", "incompressible",
-                 "--params", str(out)]) == 0
+                 "--oat-c", _oat_c(flight), "--params", str(out)]) == 0
     loaded = MAVParmDict()
     loaded.load(str(out))
     assert loaded["ARSPD_RATIO"] == pytest.approx(2.0 / (1.225 * 0.82), rel=4e-3)

@@ -168,6 +168,7 @@ def run(args):
         if autopilot is None:
             raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
                                 "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
+        _check_params_temperature(flight, args.oat_c)
     flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
     result = identify(flight, model=args.model, air=args.air,
                       gps_noise_std_mps=args.gps_noise_mps)
@@ -204,6 +205,18 @@ def run(args):
     if params is not None:
         _print_params(params, args.params)
     return 0
+
+
+def _check_params_temperature(flight, oat_c):
+    """Refuse to recommend a parameter from a density made of a sensor temperature: a sensor
+    15 K warmer than the air moves ARSPD_RATIO by ~5 %, far outside the fit's 2σ."""
+    from pitotcal.core.errors import PitotcalError
+
+    source = str(flight.meta.get("temperature_source", ""))
+    if oat_c is None and "sensor temperature, not OAT" in source:
+        raise PitotcalError(f"--params: {flight.source} has no outside air temperature (density "
+                            f"from {source.split(':')[0]}, a sensor's); a sensor 15 K warm moves "
+                            "the recommended value by ~5 %: give the OAT with --oat-c")
 
 
 def _write_plot(path, result, budget):
