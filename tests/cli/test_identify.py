@@ -317,3 +317,12 @@ def test_budget_and_air_options_refused(flight_csv, capsys, argv, flag):
     assert main(["identify", str(path), *argv]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and flag in err
+
+
+def test_no_flight_and_no_live_connection_says_what_to_give(capsys):
+    from pitotcal.cli import main
+
+    assert main(["identify"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "pitotcal identify: give the FLIGHT to identify (a flight CSV or a ULog/DataFlash log), "
+        "or --live CONNECTION")

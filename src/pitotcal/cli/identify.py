@@ -302,7 +302,10 @@ def _run_live(args):
     from pitotcal.core.models import MODELS
     from pitotcal.estimation.live import identify_stream
 
-    if (args.live is None) == (args.flight is None):
+    if args.live is None and args.flight is None:
+        raise PitotcalError("give the FLIGHT to identify (a flight CSV or a ULog/DataFlash log), "
+                            "or --live CONNECTION")
+    if args.live is not None and args.flight is not None:
         raise PitotcalError("give either FLIGHT (a file) or --live CONNECTION, not both")
     choice("model", args.model, list(MODELS))
     positive("target_2sigma_kt", args.target_2sigma_kt)
