@@ -48,11 +48,16 @@ class SimOptions:
     gps_noise_mps: float
     gps_latency_s: float
     air_data: str = "incompressible"
+    # Gauss-Markov GPS velocity error (issue 11): steady-state sigma (m/s; 0 none), tau (s)
+    gps_gm_sigma_mps: float = 0.0
+    gps_gm_tau_s: float = 30.0
 
     def to_dict(self):
         """As written in the truth JSON (sequences as lists)."""
         out = asdict(self)
         out["k"], out["wind_drift_mps2"] = list(self.k), list(self.wind_drift_mps2)
+        if not self.gps_gm_sigma_mps:       # without it, the truth JSON stays as it was
+            del out["gps_gm_sigma_mps"], out["gps_gm_tau_s"]
         return out
 
 
@@ -88,7 +93,7 @@ def _true_k(model, k):
 def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, turbulence_mps,
              turbulence_length_m, rate_hz, qc_noise_pa, qc_quantization_pa, qc_bias_pa,
              qc_scale_error, pneumatic_lag_s, gps_rate_hz, gps_noise_mps, gps_latency_s,
-             air_data="incompressible"):
+             air_data="incompressible", gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0):
     """`SimOptions` from `simulate`'s arguments (see there): each checked, naming the parameter,
     the wind's defaults filled from the plan's settings, sizes checked against the plan."""
     settings = plan.settings or {}
@@ -118,7 +123,9 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
         gps_rate_hz=number("gps_rate_hz", gps_rate_hz or 0.0, 0.0),
         gps_noise_mps=number("gps_noise_mps", gps_noise_mps, 0.0),
         gps_latency_s=number("gps_latency_s", gps_latency_s, 0.0),
-        air_data=choice("air_data", air_data, AIR_DATA_MODES))
+        air_data=choice("air_data", air_data, AIR_DATA_MODES),
+        gps_gm_sigma_mps=number("gps_gm_sigma_mps", gps_gm_sigma_mps, 0.0),
+        gps_gm_tau_s=positive("gps_gm_tau_s", gps_gm_tau_s))
     span_s = float(plan.time_s[-1] - plan.time_s[0])
     samples = span_s * opts.rate_hz + 1
     if samples > MAX_SAMPLES:

@@ -210,7 +210,8 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
                                  noise_pa=opts.qc_noise_pa,
                                  quantization_pa=opts.qc_quantization_pa)
     gps = gps_velocity_sensor(t, vel, rng_gps, rate_hz=opts.gps_rate_hz,
-                              noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s)
+                              noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s,
+                              gm_sigma_mps=opts.gps_gm_sigma_mps, gm_tau_s=opts.gps_gm_tau_s)
     meta = {"generator": "pitotcal simulate", "seed": seed, "model": opts.model,
             **dict(zip(get_model(opts.model).params, opts.k)),
             "wind_speed_mps": opts.wind_speed_mps, "wind_from_deg": opts.wind_from_deg}
@@ -271,7 +272,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
              rate_hz=50.0, qc_noise_pa=0.5, qc_quantization_pa=0.0, qc_bias_pa=0.0,
              qc_scale_error=0.0, pneumatic_lag_s=0.0, gps_rate_hz=5.0, gps_noise_mps=0.05,
              gps_latency_s=0.0, air_data="incompressible", limits=None, speed_loop=None,
-             keep_history=False):
+             keep_history=False, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0):
     """Fly `plan` in simulation and record what the sensors would log.
 
     Parameters
@@ -310,6 +311,10 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
         Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
         `oat_k`. The autopilot flies the plan's true airspeed either way.
+    gps_gm_sigma_mps, gps_gm_tau_s : float
+        Time-correlated GPS velocity error on top of the white noise: first-order
+        Gauss-Markov per component, steady-state std (m/s; 0 = none, the default) and
+        correlation time (s) (`maneuvers.sensors.gauss_markov`).
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -334,7 +339,8 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     opts = sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2,
                        turbulence_mps, turbulence_length_m, rate_hz, qc_noise_pa,
                        qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s,
-                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data)
+                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data,
+                       gps_gm_sigma_mps=gps_gm_sigma_mps, gps_gm_tau_s=gps_gm_tau_s)
     seed = integer("seed", seed, 0)
     if limits is None:
         limits = Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",
