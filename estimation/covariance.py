@@ -113,14 +113,19 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     jac : ndarray, shape (N, p)
         Output sensitivities S = dr/dtheta at the optimum.
     residuals : ndarray, shape (N,)
-    window : {"exponential", "bartlett", "parzen"}
-        How R_vv is formed: "exponential" (default) models it as white noise plus an
-        exponential decay fitted to the sample autocovariance at short lags; "bartlett" and
-        "parzen" taper the sample autocovariance with that lag window.
+    window : {"multiscale", "exponential", "bartlett", "parzen"}
+        How R_vv is formed: "multiscale" (default) models it as white noise plus exponentials
+        of several correlation times, in the pressure and in the velocity
+        (`estimation.noise_model`); "exponential" as white noise plus one exponential decay
+        (the model before issue 11); "bartlett" and "parzen" taper the sample
+        autocovariance with that lag window.
     lag : int, optional
         Truncation lag of "bartlett"/"parzen", samples; Andrews' AR(1) plug-in when None.
     information : ndarray, shape (p, p), optional
         M from the exact Hessian of the objective; S^T S when None.
+    velocity : ndarray, shape (N, 2), optional
+        The residual's sensitivities to a velocity disturbance (the wind columns of S): with
+        "multiscale", GPS velocity error and gusts enter as u . d, modulated by the heading.
 
     Returns
     -------
@@ -134,27 +139,19 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
 
     and R cancels: Cov = (S^T S)^-1 S^T (H S) (S^T S)^-1 with H the Toeplitz matrix of
     h(k) = w(k) R_vv(k). H S is a convolution of each sensitivity column with h, done by FFT
-    O(N log N), never the N x N double sum. Summing every lag of a sample
-    autocovariance is degenerate (it collapses toward zero for zero-mean residuals), so R_vv
-    needs a model or a lag window. The default models it as white noise plus an exponential
-    decay, fitted to the residuals' autocovariance as the fit leaves it (`_exponential_acov`),
-    and widens the result for the few degrees of freedom of that fit (`student_t_widening`).
-    Measured by Monte Carlo on the simulator's default T-2 flight (Dryden turbulence, 5 Hz
-    held GPS, inverse model with instrumental-variable rows, 200 runs), fraction of truths
-    inside 2 sigma: 96.1% (k1 92.5%, k2 93%, wind 100% / 99%); plain bounds 8.5%. A model
-    fitted to the raw short-lag autocovariance gave 89% (k1 80%); Bartlett with Andrews'
-    plug-in lag 86% (its taper and the fit-depleted long lags both shrink it).
-    Lags count samples of the data as given;
+    O(N log N). Summing every lag of a sample autocovariance is degenerate, so R_vv needs a
+    model or a lag window; the models are fitted to the autocovariance as the fit leaves it
+    and widened for their few degrees of freedom (`student_t_widening`).
+    Coverage of each model on the noise cases: docs/measured.md ("Bounds under real noise");
+    Bartlett with Andrews' plug-in lag gave 86% on the T-2 flight. Lags count samples as given;
     time gaps are treated as adjacent samples (`OutputErrorProblem` warns when gaps are not
     rare). With white residuals this reduces to the plain s^2 (S^T S)^-1.
     """
     n, p = jac.shape
-    a = 0.0
-    dof = float("inf")
-    step = 1
-    h_vel = None
+    a, dof, step, h_vel = 0.0, float("inf"), 1, None
     if window == "multiscale":
-        h, h_vel, step, a, dof = _multiscale_acov(residuals, jac, velocity)
+        from .noise_model import multiscale_acov
+        h, h_vel, step, a, dof = multiscale_acov(residuals, jac, velocity)
         lag = (h.size - 1) * step
     elif window == "exponential":
         h, lag, a, dof = _exponential_acov(residuals, jac)
@@ -165,10 +162,11 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
         acov = residual_acf(residuals, lag) * n / max(n - p, 1)
         h = lag_weights(lag, window) * acov
     # h is the autocovariance of block means of `step` samples: S^T e = step S_b^T e_b
-    x = _block_means(jac if instruments is None else instruments, step)
+    from .noise_model import block_means
+    x = block_means(jac if instruments is None else instruments, step)
     middle = step ** 2 * (x.T @ _toeplitz_times(h, x))
     if h_vel is not None:        # e_i = u_i . d_i: sum over d's components of (x u_d)^T H (x u_d)
-        for col in _block_means(velocity, step).T:
+        for col in block_means(velocity, step).T:
             xu = x * col[:, None]
             middle += step ** 2 * (xu.T @ _toeplitz_times(h_vel, xu))
     if instruments is None:
@@ -178,9 +176,8 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
         # instrumental variables: A^-1 Z^T R_vv Z A^-T, A = Z^T S
         a_inv = np.linalg.inv(instruments.T @ jac if information is None else information)
         cov = a_inv @ (0.5 * (middle + middle.T)) @ a_inv.T
-    # The noise model is fitted to one record: with T / tau correlation times in it, the long-run
-    # variance has ~T / (4 tau) degrees of freedom (an OU process: S(0) = D tau^2, tau known to
-    # CV^2 = 2 tau / T). Widen so that +-2 sigma holds 95.45% under Student t with those dof.
+    # The noise model is fitted to one record: its long-run variance has few degrees of
+    # freedom (T / (4 tau) for one exponential, `noise_model.DOF_TAUS`): Student-t widening.
     cov = cov * student_t_widening(dof) ** 2
     # correlation time, samples: of the fitted decay, or half the window
     tau = (-1.0 / np.log(a) if window in ("exponential", "multiscale") and 0.0 < a < 1.0
@@ -246,29 +243,6 @@ def _exponential_acov(residuals, jac):
     return h, lag, a, dof
 
 
-def _multiscale_acov(residuals, jac, velocity=None):
-    """(h, step, a, dof) of `estimation.noise_model.fit_multiscale`: h the block-mean
-    autocovariance, a = exp(-1 / tau) of its long-run-weighted correlation time tau (samples),
-    dof = N / (DOF_TAUS tau); white residuals (lag-1 correlation within sampling noise of 0)
-    give h = [R(0)] at full rate."""
-    from .noise_model import fit_multiscale
-
-    n, p = jac.shape
-    acov = residual_acf(residuals, 1) * n / max(n - p, 1)
-    if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
-        return acov[:1], None, 1, float(acov[1] / acov[0]), float("inf")
-    fit = fit_multiscale(residuals, jac, velocity)
-    tau = fit.tau_samples
-    a = float(np.exp(-1.0 / tau)) if tau > 0 else 0.0
-    return fit.h, fit.h_vel, fit.step, a, (n / (MULTISCALE_DOF_TAUS * tau) if tau > 0
-                                           else float("inf"))
-
-
-def _block_means(x, step):
-    from .noise_model import block_means
-    return block_means(x, step)
-
-
 def _decay_from_increments(residuals, ke):
     """Decay time (samples) of white + exponential noise from the residuals' increments.
 
@@ -294,9 +268,6 @@ def _decay_from_increments(residuals, ke):
 FIT_SAMPLES = 4000
 # Degrees of freedom of the fitted noise model: one per DOF_TAUS correlation times.
 DOF_TAUS = 4.0
-# The same for the multiscale model, fitted to the whole autocovariance: one per correlation
-# time (measured, 60 flights per case: with 4, k1/k2 came out 1.2-1.5x too wide, rms z 0.6-0.9).
-MULTISCALE_DOF_TAUS = 1.0
 # Thinned, the 1/e lag must still span this many samples to be resolved.
 MIN_FIT_TAU = 4
 # The fit uses lags up to this many 1/e lags.

@@ -287,8 +287,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         Its true coefficients (the first as many as the model has are used); default
         `pitotcal.core.scenario.true_k(model)`: k1 = 0.02, k2 = -15 Pa for the inverse model.
     wind_speed_mps, wind_from_deg : float, optional
-        Mean wind (direction it blows FROM, deg true, in [0, 360)); default: the plan's
-        settings (else calm).
+        Mean wind (FROM, deg true, in [0, 360)); default: the plan's settings (else calm).
     wind_drift_mps2 : (float, float)
         Linear drift of the air-mass velocity (north, east), m/s^2, about the record's middle:
         wind(t) = mean + drift * (t - t_mid), so the process mean over the record is the mean.
@@ -312,9 +311,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
         `oat_k`. The autopilot flies the plan's true airspeed either way.
     gps_gm_sigma_mps, gps_gm_tau_s : float
-        Time-correlated GPS velocity error on top of the white noise: first-order
-        Gauss-Markov per component, steady-state std (m/s; 0 = none, the default) and
-        correlation time (s) (`maneuvers.sensors.gauss_markov`).
+        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s).
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -333,14 +330,13 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     Examples
     --------
     >>> flight, truth = simulate(plan, seed=1, turbulence_mps=1.0)   # doctest: +SKIP
-    >>> write_truth_json(truth, "flight.csv")                          # doctest: +SKIP
     """
     check_plan(plan)
     opts = sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2,
                        turbulence_mps, turbulence_length_m, rate_hz, qc_noise_pa,
                        qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s,
-                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data,
-                       gps_gm_sigma_mps=gps_gm_sigma_mps, gps_gm_tau_s=gps_gm_tau_s)
+                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, gps_gm_sigma_mps,
+                       gps_gm_tau_s)
     seed = integer("seed", seed, 0)
     if limits is None:
         limits = Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",
