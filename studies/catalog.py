@@ -19,6 +19,7 @@ from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
 from .legs_study import STUDY as LEGS
 from .maneuvers_study import STUDY as MANEUVERS
+from .noise import STUDY as NOISE
 from .real_alfa import STUDY as REAL_ALFA
 from .runner import RunsInterrupted, count_errors, output_folder, write_table
 from .sample_size import STUDY as SAMPLE_SIZE
@@ -32,7 +33,7 @@ log = logging.getLogger(__name__)
 
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
-                               PEERS, LEGS)}
+                               PEERS, LEGS, NOISE)}
 
 
 class StudyInterrupted(KeyboardInterrupt):
