@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .noise_model import _fast_len, _inv_sym, block_means, residual_acf
+
 __all__ = [
     "ColoredCovariance",
     "colored_covariance",
@@ -60,15 +62,6 @@ class ColoredCovariance:
 
     def describe(self):
         return f"{self.window} R_vv, {self.lag} lags (decay/AR(1) {self.ar1:.4f} per sample)"
-
-
-def residual_acf(residuals, max_lag):
-    """Biased sample autocovariance R_vv(k) = (1/N) sum_i v_i v_(i+k), k = 0..max_lag, by FFT."""
-    n = residuals.size
-    size = _fast_len(n + max_lag + 1)
-    spec = np.fft.rfft(residuals, size)
-    acov = np.fft.irfft(spec * np.conj(spec), size)[: max_lag + 1]
-    return acov / n
 
 
 def truncation_lag(residuals, window="bartlett"):
@@ -162,7 +155,6 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
         acov = residual_acf(residuals, lag) * n / max(n - p, 1)
         h = lag_weights(lag, window) * acov
     # h is the autocovariance of block means of `step` samples: S^T e = step S_b^T e_b
-    from .noise_model import block_means
     x = block_means(jac if instruments is None else instruments, step)
     middle = step ** 2 * (x.T @ _toeplitz_times(h, x))
     if h_vel is not None:        # e_i = u_i . d_i: sum over d's components of (x u_d)^T H (x u_d)
@@ -362,15 +354,6 @@ def _nnls2(b1, b2, y):
     return best if best is not None else (np.zeros(2), float(y @ y))
 
 
-def _inv_sym(m):
-    """Inverse of a symmetric positive (semi)definite matrix, pseudo-inverse if singular."""
-    try:
-        inv = np.linalg.inv(m)
-    except np.linalg.LinAlgError:
-        inv = np.linalg.pinv(m)
-    return 0.5 * (inv + inv.T)
-
-
 def _toeplitz_times(h, x):
     """H @ x for the symmetric Toeplitz H with first row h (zero beyond), by FFT.
 
@@ -386,8 +369,3 @@ def _toeplitz_times(h, x):
     conv = np.fft.irfft(np.fft.rfft(x, size, axis=0) * np.fft.rfft(kernel, size)[:, None],
                         size, axis=0)
     return conv[lag:lag + n]
-
-
-def _fast_len(n):
-    """Next power of two (numpy's FFT is fast there)."""
-    return 1 << int(np.ceil(np.log2(max(n, 2))))

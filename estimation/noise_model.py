@@ -18,7 +18,8 @@ contribution to the long-run variance, the short ones included, at a cost indepe
 
 import numpy as np
 
-__all__ = ["MultiscaleFit", "block_means", "fit_multiscale", "multiscale_acov", "nnls"]
+__all__ = ["MultiscaleFit", "block_means", "fit_multiscale", "multiscale_acov", "nnls",
+           "residual_acf"]
 
 # At most this many block means are fitted (the fit costs the same at N = 1e6 as at 16,000).
 BLOCK_SAMPLES = 1500
@@ -43,8 +44,6 @@ def multiscale_acov(residuals, jac, velocity=None):
     autocovariances of `fit_multiscale`, a = exp(-1 / tau) of its long-run-weighted
     correlation time tau (samples), dof = N / (DOF_TAUS tau). White residuals (lag-1
     correlation within sampling noise of 0) give h = [R(0)] at full rate."""
-    from .covariance import residual_acf
-
     n, p = jac.shape
     acov = residual_acf(residuals, 1) * n / max(n - p, 1)
     if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
@@ -93,8 +92,6 @@ def fit_multiscale(residuals, jac, velocity=None):
     `velocity` (N, 2): the residual's sensitivities to a velocity disturbance (the wind
     columns of `jac`); None: pressure-domain terms only.
     """
-    from .covariance import _fast_len, _inv_sym, residual_acf
-
     n, p = jac.shape
     step = max(1, int(np.ceil(n / BLOCK_SAMPLES)))
     rb, sb = block_means(residuals, step), block_means(jac, step)
@@ -208,3 +205,26 @@ def nnls(a, b, max_iter=None):
             passive &= x > 1e-15
             x[~passive] = 0.0
     return x / scale
+
+
+def residual_acf(residuals, max_lag):
+    """Biased sample autocovariance R_vv(k) = (1/N) sum_i v_i v_(i+k), k = 0..max_lag, by FFT."""
+    n = residuals.size
+    size = _fast_len(n + max_lag + 1)
+    spec = np.fft.rfft(residuals, size)
+    acov = np.fft.irfft(spec * np.conj(spec), size)[: max_lag + 1]
+    return acov / n
+
+
+def _inv_sym(m):
+    """Inverse of a symmetric positive (semi)definite matrix, pseudo-inverse if singular."""
+    try:
+        inv = np.linalg.inv(m)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(m)
+    return 0.5 * (inv + inv.T)
+
+
+def _fast_len(n):
+    """Next power of two (numpy's FFT is fast there)."""
+    return 1 << int(np.ceil(np.log2(max(n, 2))))
