@@ -98,7 +98,7 @@ def figure(summary):
     a.set_xticks(pos, names)
     a.set_ylim(0, 1.05)
     a.set_ylabel("fraction of truths inside ±2σ")
-    a.legend(fontsize=8, loc="lower right")
+    a.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncols=5)
     return fig
 
 
