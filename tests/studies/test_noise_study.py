@@ -28,7 +28,7 @@ def test_noise_lean(tmp_path):
 
 @pytest.mark.slow
 def test_noise_full_size(tmp_path):
-    """Issue 11's cases over 100 flights each (~15 min on 2 cores): every parameter and the
+    """Issue 11's cases over 100 flights each (~1-2 min on 2 cores): every parameter and the
     table rows covered 90% or more, rms z near 1 (docs/measured.md has what each case gives)."""
     summary = run_study("noise", runs=100, out_dir=tmp_path, workers=2, seed=0)
     for name, case in summary["cases"].items():
