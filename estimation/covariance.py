@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .noise_model import _fast_len, _inv_sym, block_means, residual_acf
+
 __all__ = [
     "ColoredCovariance",
     "colored_covariance",
@@ -62,15 +64,6 @@ class ColoredCovariance:
         return f"{self.window} R_vv, {self.lag} lags (decay/AR(1) {self.ar1:.4f} per sample)"
 
 
-def residual_acf(residuals, max_lag):
-    """Biased sample autocovariance R_vv(k) = (1/N) sum_i v_i v_(i+k), k = 0..max_lag, by FFT."""
-    n = residuals.size
-    size = _fast_len(n + max_lag + 1)
-    spec = np.fft.rfft(residuals, size)
-    acov = np.fft.irfft(spec * np.conj(spec), size)[: max_lag + 1]
-    return acov / n
-
-
 def truncation_lag(residuals, window="bartlett"):
     """Andrews' (1991) AR(1) plug-in truncation lag, samples, and the fitted AR(1) coefficient.
 
@@ -104,8 +97,8 @@ def lag_weights(lag, window="bartlett"):
     return np.where(x <= 0.5, 1 - 6 * x ** 2 + 6 * x ** 3, 2 * (1 - x) ** 3)
 
 
-def colored_covariance(jac, residuals, *, window="exponential", lag=None, information=None,
-                       instruments=None):
+def colored_covariance(jac, residuals, *, window="multiscale", lag=None, information=None,
+                       instruments=None, velocity=None):
     """Covariance corrected for colored residuals (Morelli & Klein 1997; SIDPAC `colores`).
 
     Parameters
@@ -113,14 +106,19 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None, inform
     jac : ndarray, shape (N, p)
         Output sensitivities S = dr/dtheta at the optimum.
     residuals : ndarray, shape (N,)
-    window : {"exponential", "bartlett", "parzen"}
-        How R_vv is formed: "exponential" (default) models it as white noise plus an
-        exponential decay fitted to the sample autocovariance at short lags; "bartlett" and
-        "parzen" taper the sample autocovariance with that lag window.
+    window : {"multiscale", "exponential", "bartlett", "parzen"}
+        How R_vv is formed: "multiscale" (default) models it as white noise plus exponentials
+        of several correlation times, in the pressure and in the velocity
+        (`estimation.noise_model`); "exponential" as white noise plus one exponential decay
+        (the model before issue 11); "bartlett" and "parzen" taper the sample
+        autocovariance with that lag window.
     lag : int, optional
         Truncation lag of "bartlett"/"parzen", samples; Andrews' AR(1) plug-in when None.
     information : ndarray, shape (p, p), optional
         M from the exact Hessian of the objective; S^T S when None.
+    velocity : ndarray, shape (N, 2), optional
+        The residual's sensitivities to a velocity disturbance (the wind columns of S): with
+        "multiscale", GPS velocity error and gusts enter as u . d, modulated by the heading.
 
     Returns
     -------
@@ -134,24 +132,21 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None, inform
 
     and R cancels: Cov = (S^T S)^-1 S^T (H S) (S^T S)^-1 with H the Toeplitz matrix of
     h(k) = w(k) R_vv(k). H S is a convolution of each sensitivity column with h, done by FFT
-    O(N log N), never the N x N double sum. Summing every lag of a sample
-    autocovariance is degenerate (it collapses toward zero for zero-mean residuals), so R_vv
-    needs a model or a lag window. The default models it as white noise plus an exponential
-    decay, fitted to the residuals' autocovariance as the fit leaves it (`_exponential_acov`),
-    and widens the result for the few degrees of freedom of that fit (`student_t_widening`).
-    Measured by Monte Carlo on the simulator's default T-2 flight (Dryden turbulence, 5 Hz
-    held GPS, inverse model with instrumental-variable rows, 200 runs), fraction of truths
-    inside 2 sigma: 96.1% (k1 92.5%, k2 93%, wind 100% / 99%); plain bounds 8.5%. A model
-    fitted to the raw short-lag autocovariance gave 89% (k1 80%); Bartlett with Andrews'
-    plug-in lag 86% (its taper and the fit-depleted long lags both shrink it).
-    Lags count samples of the data as given;
+    O(N log N). Summing every lag of a sample autocovariance is degenerate, so R_vv needs a
+    model or a lag window; the models are fitted to the autocovariance as the fit leaves it
+    and widened for their few degrees of freedom (`student_t_widening`).
+    Coverage of each model on the noise cases: docs/measured.md ("Bounds under real noise");
+    Bartlett with Andrews' plug-in lag gave 86% on the T-2 flight. Lags count samples as given;
     time gaps are treated as adjacent samples (`OutputErrorProblem` warns when gaps are not
     rare). With white residuals this reduces to the plain s^2 (S^T S)^-1.
     """
     n, p = jac.shape
-    a = 0.0
-    dof = float("inf")
-    if window == "exponential":
+    a, dof, step, h_vel = 0.0, float("inf"), 1, None
+    if window == "multiscale":
+        from .noise_model import multiscale_acov
+        h, h_vel, step, a, dof = multiscale_acov(residuals, jac, velocity)
+        lag = (h.size - 1) * step
+    elif window == "exponential":
         h, lag, a, dof = _exponential_acov(residuals, jac)
     else:
         if lag is None:
@@ -159,22 +154,26 @@ def colored_covariance(jac, residuals, *, window="exponential", lag=None, inform
         lag = int(min(lag, n - 1))
         acov = residual_acf(residuals, lag) * n / max(n - p, 1)
         h = lag_weights(lag, window) * acov
+    # h is the autocovariance of block means of `step` samples: S^T e = step S_b^T e_b
+    x = block_means(jac if instruments is None else instruments, step)
+    middle = step ** 2 * (x.T @ _toeplitz_times(h, x))
+    if h_vel is not None:        # e_i = u_i . d_i: sum over d's components of (x u_d)^T H (x u_d)
+        for col in block_means(velocity, step).T:
+            xu = x * col[:, None]
+            middle += step ** 2 * (xu.T @ _toeplitz_times(h_vel, xu))
     if instruments is None:
-        hs = _toeplitz_times(h, jac)
         m_inv = _inv_sym(jac.T @ jac if information is None else information)
-        middle = jac.T @ hs
         cov = m_inv @ (0.5 * (middle + middle.T)) @ m_inv
     else:
         # instrumental variables: A^-1 Z^T R_vv Z A^-T, A = Z^T S
         a_inv = np.linalg.inv(instruments.T @ jac if information is None else information)
-        middle = instruments.T @ _toeplitz_times(h, instruments)
         cov = a_inv @ (0.5 * (middle + middle.T)) @ a_inv.T
-    # The noise model is fitted to one record: with T / tau correlation times in it, the long-run
-    # variance has ~T / (4 tau) degrees of freedom (an OU process: S(0) = D tau^2, tau known to
-    # CV^2 = 2 tau / T). Widen so that +-2 sigma holds 95.45% under Student t with those dof.
+    # The noise model is fitted to one record: its long-run variance has few degrees of
+    # freedom (T / (4 tau) for one exponential, `noise_model.DOF_TAUS`): Student-t widening.
     cov = cov * student_t_widening(dof) ** 2
     # correlation time, samples: of the fitted decay, or half the window
-    tau = -1.0 / np.log(a) if window == "exponential" and 0.0 < a < 1.0 else lag / 2.0
+    tau = (-1.0 / np.log(a) if window in ("exponential", "multiscale") and 0.0 < a < 1.0
+           else lag / 2.0)
     stretches = n / max(2.0 * tau, 1.0)
     warning = None
     if stretches < MIN_STRETCHES:
@@ -355,15 +354,6 @@ def _nnls2(b1, b2, y):
     return best if best is not None else (np.zeros(2), float(y @ y))
 
 
-def _inv_sym(m):
-    """Inverse of a symmetric positive (semi)definite matrix, pseudo-inverse if singular."""
-    try:
-        inv = np.linalg.inv(m)
-    except np.linalg.LinAlgError:
-        inv = np.linalg.pinv(m)
-    return 0.5 * (inv + inv.T)
-
-
 def _toeplitz_times(h, x):
     """H @ x for the symmetric Toeplitz H with first row h (zero beyond), by FFT.
 
@@ -379,8 +369,3 @@ def _toeplitz_times(h, x):
     conv = np.fft.irfft(np.fft.rfft(x, size, axis=0) * np.fft.rfft(kernel, size)[:, None],
                         size, axis=0)
     return conv[lag:lag + n]
-
-
-def _fast_len(n):
-    """Next power of two (numpy's FFT is fast there)."""
-    return 1 << int(np.ceil(np.log2(max(n, 2))))

@@ -266,10 +266,10 @@ def _refine(model, built, x_opt, p_val, weight, ch, time_s):
     residuals = residual(model, theta, *ch.args)
     cov_plain = plain_covariance(jac, residuals, information=info)
     if instruments is None:
-        colored = colored_covariance(jac, residuals, information=info)
+        colored = colored_covariance(jac, residuals, information=info, velocity=jac[:, -2:])
     else:
         colored = colored_covariance(jac, residuals, information=instruments.T @ jac,
-                                     instruments=instruments)
+                                     instruments=instruments, velocity=jac[:, -2:])
     warn += [w for w in (colored.warning, _gap_warning(time_s)) if w]
     return _Fit(theta, residuals, cov_plain, colored, tuple(warn))
 

@@ -116,7 +116,8 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
                                  noise_pa=opts.qc_noise_pa, quantization_pa=opts.qc_quantization_pa)
     vel = np.column_stack([record["vn_mps"], record["ve_mps"], record["vd_mps"]])
     gps = gps_velocity_sensor(t, vel, rng_gps, rate_hz=opts.gps_rate_hz,
-                              noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s)
+                              noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s,
+                              gm_sigma_mps=opts.gps_gm_sigma_mps, gm_tau_s=opts.gps_gm_tau_s)
     # the static port reads p_s + Δp_p with all the pressure error in the static source (the
     # total pressure exact), Δp_p = q_c − q_ci at the probe: as maneuvers.simulator does
     model = get_model(opts.model)

@@ -9,12 +9,12 @@ reports it at its own rate; the logger holds the last report until the next (sam
 
 import numpy as np
 
-from pitotcal.core.checks import number
+from pitotcal.core.checks import number, positive
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model, qci_from_qc_pa
 from pitotcal.core.scenario import true_k
 
-__all__ = ["air_records", "first_order_lag", "gps_velocity_sensor", "hold_index",
+__all__ = ["air_records", "first_order_lag", "gauss_markov", "gps_velocity_sensor", "hold_index",
            "impact_pressure_sensor"]
 
 
@@ -108,7 +108,8 @@ def hold_index(time_s, rate_hz):
     return np.searchsorted(t, tick - 1e-9)
 
 
-def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, latency_s=0.0):
+def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, latency_s=0.0,
+                        gm_sigma_mps=0.0, gm_tau_s=30.0):
     """GPS velocity as logged: delayed, noisy, updated at `rate_hz` and held in between.
 
     Parameters
@@ -125,6 +126,10 @@ def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, la
         White-noise standard deviation per component and update, m/s.
     latency_s : float
         Age of the reported velocity, s (>= 0); before the record starts the first value is used.
+    gm_sigma_mps, gm_tau_s : float
+        Time-correlated error on top of the white noise: a first-order Gauss-Markov process
+        per component, steady-state standard deviation (m/s; 0: none) and correlation time (s)
+        (`gauss_markov`).
 
     Returns
     -------
@@ -143,6 +148,8 @@ def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, la
     # One noise draw per sample, read through the hold: each update carries its own draw and
     # the result does not depend on how many updates there are before a given sample.
     noise = rng.standard_normal(vel.shape) * noise_mps
+    if gm_sigma_mps > 0:      # drawn after the white noise: flights without it stay as they were
+        noise = noise + gauss_markov(t, vel.shape[1], rng, gm_sigma_mps, gm_tau_s)
     return vel[held] + noise[held]
 
 
@@ -199,3 +206,31 @@ def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
     if sensors.rh_pct > 0:
         columns["rh_pct"] = np.full(alt.size, sensors.rh_pct)
     return qc, ps_read / (R_AIR_JKGK * logged_t), columns
+
+
+def gauss_markov(time_s, n_comp, rng, sigma, tau_s):
+    """First-order Gauss-Markov process x' = -x / tau + w, stationary from the start.
+
+    Exact discretisation x_(i+1) = phi x_i + sqrt(1 - phi^2) sigma e_i, phi = exp(-dt / tau),
+    on the sample times `time_s`; shape (N, n_comp), steady-state standard deviation `sigma`.
+    The GPS velocity error of a receiver's tracking loops and multipath drifts like this
+    (tens of seconds), which white noise does not describe.
+    """
+    from scipy.signal import lfilter
+
+    sigma = number("gps_gm_sigma_mps", sigma, 0.0)
+    tau_s = positive("gps_gm_tau_s", tau_s)
+    t = np.asarray(time_s, dtype=float)
+    dt = np.diff(t, prepend=t[0])
+    phi = np.exp(-dt / tau_s)
+    e = rng.standard_normal((t.size, n_comp))
+    drive = np.sqrt(1.0 - phi ** 2)[:, None] * e
+    drive[0] = e[0]                                    # stationary start
+    if np.allclose(dt[1:], dt[1:2]):                   # uniform step: one filter pass
+        a = float(phi[1]) if t.size > 1 else 0.0
+        return sigma * lfilter([1.0], [1.0, -a], drive, axis=0)
+    x = np.empty_like(drive)
+    x[0] = drive[0]
+    for i in range(1, t.size):
+        x[i] = phi[i] * x[i - 1] + drive[i]
+    return sigma * x

@@ -10,7 +10,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from pitotcal.core.airdata import AIR_DATA_MODES
-from pitotcal.core.checks import choice, exact, number, round_to_limit
+from pitotcal.core.checks import choice, exact, number, positive, round_to_limit
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model
 from pitotcal.core.plan import Plan
@@ -39,6 +39,7 @@ SIM_LIMITS = {
     "pneumatic_lag_s": (5.0, "pitot tubing lags 0.01-0.5 s; seconds is a blocked line"),
     "gps_rate_hz": (100.0, "GNSS receivers update at 1-50 Hz"),
     "gps_noise_mps": (10.0, "receivers report 0.02-0.5 m/s RMS"),
+    "gps_gm_sigma_mps": (5.0, "a receiver's slowly drifting velocity error is cm/s to dm/s"),
 }
 
 
@@ -80,6 +81,9 @@ class SimOptions:
     gps_latency_s: float
     air_data: str = "incompressible"
     air_sensors: "AirSensors | None" = None
+    # Gauss-Markov GPS velocity error (issue 11): steady-state sigma (m/s; 0 none), tau (s)
+    gps_gm_sigma_mps: float = 0.0
+    gps_gm_tau_s: float = 30.0
 
     def to_dict(self):
         """As written in the truth JSON (sequences as lists; `air_sensors` only when set)."""
@@ -89,6 +93,8 @@ class SimOptions:
             del out["air_sensors"]                 # the default's truth JSON stays as it was
         else:
             out["air_sensors"]["gps_bias_mps"] = list(self.air_sensors.gps_bias_mps)
+        if not self.gps_gm_sigma_mps:       # without it, the truth JSON stays as it was
+            del out["gps_gm_sigma_mps"], out["gps_gm_tau_s"]
         return out
 
 
@@ -220,7 +226,7 @@ def _true_k(model, k):
 def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, turbulence_mps,
              turbulence_length_m, rate_hz, qc_noise_pa, qc_quantization_pa, qc_bias_pa,
              qc_scale_error, pneumatic_lag_s, gps_rate_hz, gps_noise_mps, gps_latency_s,
-             air_data="incompressible", sensors=None):
+             air_data="incompressible", sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0):
     """`SimOptions` from `simulate`'s arguments (see there): each checked, naming the parameter,
     the wind's defaults filled from the plan's settings, sizes checked against the plan."""
     settings = plan.settings or {}
@@ -253,7 +259,9 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
         gps_noise_mps=_limited("gps_noise_mps", gps_noise_mps),
         gps_latency_s=number("gps_latency_s", gps_latency_s, 0.0),   # bounded by the plan
         air_data=choice("air_data", air_data, AIR_DATA_MODES),
-        air_sensors=_checked_air_sensors(sensors))
+        air_sensors=_checked_air_sensors(sensors),
+        gps_gm_sigma_mps=_limited("gps_gm_sigma_mps", gps_gm_sigma_mps),
+        gps_gm_tau_s=positive("gps_gm_tau_s", gps_gm_tau_s))
     span_s = float(plan.time_s[-1] - plan.time_s[0])
     _check_samples(opts.rate_hz, span_s)
     _check_pressure_error(opts, plan)

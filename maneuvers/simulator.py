@@ -214,7 +214,8 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
                                  noise_pa=opts.qc_noise_pa,
                                  quantization_pa=opts.qc_quantization_pa)
     gps = gps_velocity_sensor(t, vel, rng_gps, rate_hz=opts.gps_rate_hz,
-                              noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s)
+                              noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s,
+                              gm_sigma_mps=opts.gps_gm_sigma_mps, gm_tau_s=opts.gps_gm_tau_s)
     if opts.air_sensors is not None:
         gps = gps + np.asarray(opts.air_sensors.gps_bias_mps)
     meta = {"generator": "pitotcal simulate", "seed": seed, "model": opts.model,
@@ -277,7 +278,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
              rate_hz=50.0, qc_noise_pa=0.5, qc_quantization_pa=0.0, qc_bias_pa=0.0,
              qc_scale_error=0.0, pneumatic_lag_s=0.0, gps_rate_hz=5.0, gps_noise_mps=0.05,
              gps_latency_s=0.0, air_data="incompressible", limits=None, speed_loop=None,
-             keep_history=False, air_sensors=None):
+             keep_history=False, air_sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0):
     """Fly `plan` in simulation and record what the sensors would log.
 
     Parameters
@@ -292,8 +293,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         Its true coefficients (the first as many as the model has are used); default
         `pitotcal.core.scenario.true_k(model)`: k1 = 0.02, k2 = -15 Pa for the inverse model.
     wind_speed_mps, wind_from_deg : float, optional
-        Mean wind (direction it blows FROM, deg true, in [0, 360)); default: the plan's
-        settings (else calm).
+        Mean wind (FROM, deg true, in [0, 360)); default: the plan's settings (else calm).
     wind_drift_mps2 : (float, float)
         Linear drift of the air-mass velocity (north, east), m/s^2, about the record's middle:
         wind(t) = mean + drift * (t - t_mid), so the process mean over the record is the mean.
@@ -316,6 +316,8 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
         Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
         `oat_k`. The autopilot flies the plan's true airspeed either way.
+    gps_gm_sigma_mps, gps_gm_tau_s : float
+        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s).
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -335,13 +337,13 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     Examples
     --------
     >>> flight, truth = simulate(plan, seed=1, turbulence_mps=1.0)   # doctest: +SKIP
-    >>> write_truth_json(truth, "flight.csv")                          # doctest: +SKIP
     """
     check_plan(plan)
     opts = sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2,
                        turbulence_mps, turbulence_length_m, rate_hz, qc_noise_pa,
                        qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s,
-                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, air_sensors)
+                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, air_sensors,
+                       gps_gm_sigma_mps, gps_gm_tau_s)
     seed = integer("seed", seed, 0)
     if limits is None:
         limits = Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",

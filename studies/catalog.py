@@ -23,6 +23,7 @@ from .legs_study import STUDY as LEGS
 from .design_study import STUDY as DESIGN
 from .maneuvers_study import STUDY as MANEUVERS
 from .monitor_study import STUDY as MONITOR
+from .noise import STUDY as NOISE
 from .real_alfa import STUDY as REAL_ALFA
 from .runner import RunsInterrupted, count_errors, output_folder, write_table
 from .sample_size import STUDY as SAMPLE_SIZE
@@ -37,7 +38,7 @@ log = logging.getLogger(__name__)
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
                                PEERS, LEGS, DESIGN, MONITOR, BUDGET,
-                               LEGS_FLIGHT)}
+                               LEGS_FLIGHT, NOISE)}
 
 
 class StudyInterrupted(KeyboardInterrupt):

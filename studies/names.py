@@ -2,4 +2,4 @@
 parser from them without loading the studies); `studies.catalog.STUDIES` holds the studies."""
 
 STUDY_NAMES = ("sample-size", "maneuvers", "sensitivity", "coverage", "wind", "real-alfa",
-               "peers", "legs", "design", "monitor", "budget", "legs-flight")
+               "peers", "legs", "design", "monitor", "budget", "legs-flight", "noise")

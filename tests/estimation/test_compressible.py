@@ -97,7 +97,10 @@ def test_incompressible_fit_shows_the_bias(flown):
     dv, band = incompressible.delta_v_kt(vi)
     miss = dv - delta_v_kt(get_model(truth.model), truth.k, vi, "compressible")
     np.testing.assert_allclose(miss[[0, -1]], INCOMPRESSIBLE_MISS_KT[name], atol=0.02)
-    assert np.all(np.abs(miss[1:]) > 3 * band[1:])        # far outside its own band
+    # outside its own band; the multiscale noise model (issue 11) counts the misfit's slow
+    # structure in the residuals as colored noise, so the band of a misspecified fit is wider
+    # than the correctly specified one's (x15 here), no longer 3x below the miss
+    assert np.all(np.abs(miss[1:]) > band[1:])
 
 
 def test_rho_only_flight_is_fitted_incompressible_with_a_warning(flown):

@@ -36,7 +36,7 @@ def test_summary_keys_and_files(alfa_summary):
 
 def test_headline(alfa_summary):
     s, _ = alfa_summary
-    assert s["headline"].startswith("k1 = 0.167 ± 0.035 (2σ), ArduPilot ratio 1.96 ± 0.08 "
+    assert s["headline"].startswith("k1 = 0.167 ± 0.034 (2σ), ArduPilot ratio 1.96 ± 0.08 "
                                     "(the autopilot flew 1.898); wind 1.8 ± 0.5 m/s from 337")
 
 

@@ -38,6 +38,10 @@ def add_parser(subparsers):
     s.add_argument("--gps-noise-mps", type=float, default=0.05,
                    help="GPS velocity noise std (0.05)")
     s.add_argument("--gps-latency-s", type=float, default=0.0, help="GPS velocity latency (0)")
+    s.add_argument("--gps-gm-sigma-mps", type=float, default=0.0,
+                   help="time-correlated (Gauss-Markov) GPS velocity error std, m/s (0: none)")
+    s.add_argument("--gps-gm-tau-s", type=float, default=30.0,
+                   help="its correlation time, s (30)")
     g.add_argument("--air-data", default=None,
                    help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
                         "the paper's eq. 2; default) or compressible (isentropic, ISA p and T); "
@@ -180,7 +184,8 @@ def run(args):
         qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
         gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
-        keep_history=fault is not None, **_air_sensor_option(args))
+        keep_history=fault is not None, gps_gm_sigma_mps=args.gps_gm_sigma_mps,
+        gps_gm_tau_s=args.gps_gm_tau_s, **_air_sensor_option(args))
     if fault is not None:
         from pitotcal.maneuvers.faults import apply_fault
         flight = apply_fault(flight, truth, fault)

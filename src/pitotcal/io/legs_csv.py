@@ -157,8 +157,6 @@ def write_legs(legs, path, comments=()):
     extra = {"duration_s": legs.duration_s,
              "groundspeed_sd_kt": legs.groundspeed_sd_mps / KT_TO_MPS}
     cols += [c for c, v in extra.items() if np.any(np.isfinite(v))]
-    from .atomic import atomic_open
-
     with atomic_open(path, "w", newline="", encoding="utf-8") as f:
         f.writelines(f"# {line}\n" for line in comments)
         w = csv.writer(f, lineterminator="\n")

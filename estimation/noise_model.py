@@ -1,0 +1,230 @@
+"""A residual noise model of several time scales for the colored-residual covariance.
+
+Real residuals mix time scales: 5 Hz held GPS noise (tenths of a second), turbulence (seconds)
+and the GPS receiver's slowly drifting velocity error (tens of seconds). One white + one
+exponential term, fitted where the autocovariance first falls to 1/e, follows the fastest of
+them and misses the slow ones that dominate the parameters' variance (coverage 63% of table
+rows with 0.5 m/s GPS noise in 0.5 m/s turbulence, docs/measured.md).
+
+Here the residual autocovariance is modelled as white noise plus a non-negative mix of
+exponentials on a log-spaced grid of correlation times (a completely monotone autocovariance),
+fitted by non-negative least squares to the autocovariance the residuals should show after
+the fit has removed what lies along the sensitivities (projection-aware, as
+`covariance._fit_projected`). The fit and the sandwich are formed on block means of
+`step` samples (at most BLOCK_SAMPLES blocks): the sensitivities barely change within a block,
+so S^T e = step * S_b^T e_b to that order and the block means carry every time scale's
+contribution to the long-run variance, the short ones included, at a cost independent of N.
+"""
+
+import numpy as np
+
+__all__ = ["MultiscaleFit", "block_means", "fit_multiscale", "multiscale_acov", "nnls",
+           "residual_acf"]
+
+# At most this many block means are fitted (the fit costs the same at N = 1e6 as at 16,000).
+BLOCK_SAMPLES = 1500
+# Correlation times of the grid, in blocks: from half a block to a quarter of the record,
+# spaced by this ratio.
+TAU_RATIO = 2.0
+# Lags fitted: every lag up to DENSE_LAGS, then log-spaced to a quarter of the record.
+DENSE_LAGS = 16
+LOG_LAGS = 48
+
+
+# Degrees of freedom of the fitted model's long-run variance (Student-t widening): one per
+# long-run-weighted correlation time in the record. Measured on 60 flights per case (GPS 0.5 m/s
+# + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
+# module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
+# Gauss-Markov case at 85% coverage.
+DOF_TAUS = 1.0
+
+
+def multiscale_acov(residuals, jac, velocity=None):
+    """(h, h_vel, step, a, dof) for `covariance.colored_covariance`: the block-mean
+    autocovariances of `fit_multiscale`, a = exp(-1 / tau) of its long-run-weighted
+    correlation time tau (samples), dof = N / (DOF_TAUS tau). White residuals (lag-1
+    correlation within sampling noise of 0) give h = [R(0)] at full rate."""
+    n, p = jac.shape
+    acov = residual_acf(residuals, 1) * n / max(n - p, 1)
+    if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
+        return acov[:1], None, 1, float(acov[1] / acov[0]), float("inf")
+    fit = fit_multiscale(residuals, jac, velocity)
+    tau = fit.tau_samples
+    a = float(np.exp(-1.0 / tau)) if tau > 0 else 0.0
+    return fit.h, fit.h_vel, fit.step, a, (n / (DOF_TAUS * tau) if tau > 0 else float("inf"))
+
+
+class MultiscaleFit:
+    """Fitted block-mean autocovariances, k = 0..lag: `h` of the noise in the pressure itself
+    and `h_vel` of a velocity disturbance d (GPS velocity error, gusts) that reaches the
+    residual as u . d, u the wind sensitivities; and their summary numbers."""
+
+    def __init__(self, h, h_vel, step, terms, white):
+        self.h, self.h_vel, self.step = h, h_vel, step
+        self.terms, self.white = terms, white   # [(kind, tau in blocks, amplitude)]
+
+    @property
+    def tau_samples(self):
+        """Long-run-variance-weighted correlation time, samples (0 for white noise)."""
+        lrv = np.array([2.0 * a * t * g for _, t, a, g in self.terms])
+        taus = np.array([t for _, t, _, _ in self.terms])
+        total = self.white + lrv.sum()
+        return float(self.step * (lrv * taus).sum() / total) if total > 0 else 0.0
+
+    def describe(self):
+        parts = [f" + {kind} {a:.3g} x {t * self.step:.0f} samples"
+                 for kind, t, a, _ in self.terms]
+        return f"white {self.white:.3g} Pa^2" + "".join(parts)
+
+
+def block_means(x, step):
+    """Means of consecutive blocks of `step` rows (the remainder < step rows dropped)."""
+    x = np.asarray(x, dtype=float)
+    if step <= 1:
+        return x
+    m = x.shape[0] // step
+    return x[: m * step].reshape(m, step, *x.shape[1:]).mean(axis=1)
+
+
+def fit_multiscale(residuals, jac, velocity=None):
+    """The `MultiscaleFit` of `residuals` at the sensitivities `jac` (N, p).
+
+    `velocity` (N, 2): the residual's sensitivities to a velocity disturbance (the wind
+    columns of `jac`); None: pressure-domain terms only.
+    """
+    n, p = jac.shape
+    step = max(1, int(np.ceil(n / BLOCK_SAMPLES)))
+    rb, sb = block_means(residuals, step), block_means(jac, step)
+    m = rb.size
+    kmax = max(int(m // 4), 2)
+    lags = np.unique(np.concatenate([np.arange(min(DENSE_LAGS, kmax) + 1),
+                                     np.geomspace(DENSE_LAGS, kmax, LOG_LAGS).round()]))
+    lags = lags[lags <= kmax].astype(int)
+    obs = residual_acf(rb, kmax)[lags] * m / max(m - p, 1)
+    taus = np.exp(np.arange(np.log(0.5), np.log(kmax) + 1e-9, np.log(TAU_RATIO)))
+    ub = None if velocity is None else block_means(velocity, step)
+    basis = _projected_basis(sb, kmax, _inv_sym, _fast_len)
+    cols, kinds = [basis(np.ones(1))[lags]], [("white", 0.0)]
+    gain = 1.0
+    if ub is not None:
+        gain = float(np.mean(np.sum(ub * ub, axis=1)))      # u.u: d's variance -> Pa^2
+    for kind, mod in (("pressure", None), ("velocity", ub)):
+        if kind == "velocity" and ub is None:
+            continue
+        for tau in taus:
+            cols.append(basis(np.exp(-np.arange(_span(tau, m) + 1) / tau), mod)[lags])
+            kinds.append((kind, tau))
+    coef = nnls(np.column_stack(cols), obs)
+    terms = [(kind, tau, float(c), gain if kind == "velocity" else 1.0)
+             for (kind, tau), c in zip(kinds[1:], coef[1:]) if c > 0]
+    lag = max((_span(t, m) for _, t, _, _ in terms), default=0)
+    k = np.arange(lag + 1)
+    h, h_vel = np.zeros(lag + 1), np.zeros(lag + 1)
+    for kind, tau, amp, _ in terms:
+        (h_vel if kind == "velocity" else h)[:] += amp * np.exp(-k / tau)
+    h[0] += coef[0]
+    return MultiscaleFit(h, h_vel if h_vel.any() else None, step, terms, float(coef[0]))
+
+
+def _span(tau, m):
+    """Lags an exponential of `tau` is summed over (down to 1e-4), below the record."""
+    return int(min(np.ceil(tau * np.log(1e4)), m - 1))
+
+
+def _projected_basis(s, kmax, inv_sym, fast_len):
+    """(h, u) -> E[acov((I - P) e)](0..kmax), P the projection on `s`, for e of
+    autocovariance h (u None) or e_i = u_i . d_i with d two independent components of
+    autocovariance h (u of shape (m, 2)).
+
+    With Sigma the covariance of e, E[sum_i r_i r_(i+k)] = sum_i Sigma_(i, i+k) - c_UV(k) -
+    c_VU(k) + c_(SC)S(k), U = S M^-1, V = Sigma S, C = M^-1 S^T V M^-1 (`covariance.
+    _fit_projected`); FFT cross-correlations, O(p m log m) per h.
+    """
+    m = s.shape[0]
+    minv = inv_sym(s.T @ s)
+    size = fast_len(2 * m)
+    fs = np.fft.rfft(s, size, axis=0)
+    fu = fs @ minv
+    lags = np.arange(kmax + 1)
+
+    def toeplitz(fh, x):
+        return np.fft.irfft(np.fft.rfft(x, size, axis=0) * fh[:, None], size, axis=0)[:m]
+
+    def basis(h, u=None):
+        circ = np.zeros(size)
+        circ[:h.size] = h
+        if h.size > 1:
+            circ[size - h.size + 1:] = h[:0:-1]
+        fh = np.fft.rfft(circ)
+        own = np.zeros(kmax + 1)
+        own[:min(h.size, kmax + 1)] = h[:kmax + 1]
+        if u is None:
+            v = np.fft.irfft(fs * fh[:, None], size, axis=0)[:m]
+            own = (m - lags) * own
+        else:
+            v = sum(u[:, [d]] * toeplitz(fh, u[:, [d]] * s) for d in range(u.shape[1]))
+            fuu = np.fft.rfft(u, size, axis=0)
+            own = own * np.fft.irfft(np.sum(np.abs(fuu) ** 2, axis=1), size)[:kmax + 1]
+        fv = np.fft.rfft(v, size, axis=0)
+        fsc = fs @ (minv @ (s.T @ v) @ minv)
+        cross = np.fft.irfft(np.sum(np.conj(fu) * fv + np.conj(fv) * fu - np.conj(fsc) * fs,
+                                    axis=1), size)[:kmax + 1]
+        return (own - cross) / m
+
+    return basis
+
+
+def nnls(a, b, max_iter=None):
+    """min |a x - b| subject to x >= 0 (Lawson & Hanson 1974, active set).
+
+    A dozen columns: importing scipy.optimize for it would cost 1-3 s, more than the whole
+    identification.
+    """
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    n = a.shape[1]
+    x = np.zeros(n)
+    passive = np.zeros(n, dtype=bool)
+    scale = np.linalg.norm(a, axis=0)
+    scale[scale == 0] = 1.0
+    a = a / scale
+    tol = 1e-12 * max(1.0, float(np.abs(a.T @ b).max(initial=0.0)))
+    for _ in range(max_iter or 3 * n):
+        w = a.T @ (b - a @ x)
+        if passive.all() or np.max(np.where(passive, -np.inf, w)) <= tol:
+            break
+        passive[int(np.argmax(np.where(passive, -np.inf, w)))] = True
+        while True:
+            z = np.zeros(n)
+            z[passive] = np.linalg.lstsq(a[:, passive], b, rcond=None)[0]
+            if np.all(z[passive] > 0):
+                x = z
+                break
+            neg = passive & (z <= 0)
+            alpha = np.min(x[neg] / (x[neg] - z[neg]))
+            x = x + alpha * (z - x)
+            passive &= x > 1e-15
+            x[~passive] = 0.0
+    return x / scale
+
+
+def residual_acf(residuals, max_lag):
+    """Biased sample autocovariance R_vv(k) = (1/N) sum_i v_i v_(i+k), k = 0..max_lag, by FFT."""
+    n = residuals.size
+    size = _fast_len(n + max_lag + 1)
+    spec = np.fft.rfft(residuals, size)
+    acov = np.fft.irfft(spec * np.conj(spec), size)[: max_lag + 1]
+    return acov / n
+
+
+def _inv_sym(m):
+    """Inverse of a symmetric positive (semi)definite matrix, pseudo-inverse if singular."""
+    try:
+        inv = np.linalg.inv(m)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(m)
+    return 0.5 * (inv + inv.T)
+
+
+def _fast_len(n):
+    """Next power of two (numpy's FFT is fast there)."""
+    return 1 << int(np.ceil(np.log2(max(n, 2))))
