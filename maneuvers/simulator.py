@@ -333,10 +333,6 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         time_s, qci_pa, gps_vn/ve/vd_mps, rho_kgm3 (ISA at the altitude flown), alt_m.
     truth : maneuvers.truth.Truth
         The true calibration and mean wind flown, the options, and the tracking errors.
-
-    Examples
-    --------
-    >>> flight, truth = simulate(plan, seed=1, turbulence_mps=1.0)   # doctest: +SKIP
     """
     check_plan(plan)
     opts = sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2,

@@ -18,9 +18,9 @@ from pitotcal.io.jsonfile import write_json
 from .budget_study import STUDY as BUDGET
 from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
+from .design_study import STUDY as DESIGN
 from .legs_flight_study import STUDY as LEGS_FLIGHT
 from .legs_study import STUDY as LEGS
-from .design_study import STUDY as DESIGN
 from .maneuvers_study import STUDY as MANEUVERS
 from .monitor_study import STUDY as MONITOR
 from .noise import STUDY as NOISE
