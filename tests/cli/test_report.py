@@ -54,3 +54,12 @@ def test_output_on_top_of_input_refused(tmp_path, capsys):
     res.write_text(json.dumps(result_json()))
     assert main(["report", str(res), "-o", str(res)]) == 2
     assert "would overwrite the input result JSON" in capsys.readouterr().err
+
+
+def test_console_verdict_states_airspeed_and_altimeter(tmp_path, capsys):
+    res = tmp_path / "res.json"
+    res.write_text(json.dumps(result_json(dv_kt=-1.0, u_kt=1.0, dh_ft=-40.0)))
+    assert main(["report", str(res), "-o", str(tmp_path / "r.html")]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("Compliance"))
+    assert line.startswith("Compliance (23.1323): does not comply, ")
+    assert "airspeed complies, altimeter does not comply" in line

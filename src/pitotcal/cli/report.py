@@ -65,13 +65,13 @@ def run(args):
                        aircraft_path=args.aircraft, regulation=args.regulation,
                        speed_range_kt=args.speed_range_kt, json_path=args.json,
                        pdf_path=args.pdf, options=options)
-    verdict = done["compliance"].get("verdict")
-    if verdict:
-        print(f"Compliance ({args.regulation}): {verdict}, "
-              f"{done['compliance']['speed_range_kt'][0]:.1f}-"
-              f"{done['compliance']['speed_range_kt'][1]:.1f} KCAS "
-              f"({done['compliance']['speed_range_source']} range; "
-              f"{done['compliance']['uncertainty']} uncertainty)")
+    block = done["compliance"]
+    if block.get("verdict"):
+        print(f"Compliance ({args.regulation}): {block['verdict']}, "
+              f"{block['speed_range_kt'][0]:.1f}-{block['speed_range_kt'][1]:.1f} KCAS "
+              f"({block['speed_range_source']} range; {block['uncertainty']} uncertainty): "
+              f"airspeed {block['airspeed']['verdict']}, "
+              f"altimeter {block['altimeter']['verdict']}")
     for path in done["written"]:
         print(f"Wrote {path}")
     return 0
