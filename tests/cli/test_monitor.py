@@ -57,12 +57,16 @@ def test_clean_exit_0(files, capsys):
     (["--calibration", "cal.json", "--false-alarms-per-hour", "0"],
      "--false-alarms-per-hour 0 must be > 0"),
     (["--calibration", "cal.json", "--json", "leak.csv"], "would overwrite the input"),
+    (["--calibration", "cal.json", "--json", "cal.json"],
+     "--json .*cal.json: would overwrite the input calibration"),
 ])
 def test_bad_input_exit_2(files, capsys, args, match):
     import re
     args = [str(files / a) if a.endswith((".csv", ".json")) else a for a in args]
+    before = (files / "cal.json").read_bytes()
     assert main(["monitor", str(files / "leak.csv"), *args]) == 2
     assert re.search(match, capsys.readouterr().err)
+    assert (files / "cal.json").read_bytes() == before
 
 
 def test_too_short_flight(files, tmp_path, capsys):

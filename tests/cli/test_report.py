@@ -63,3 +63,17 @@ def test_console_verdict_states_airspeed_and_altimeter(tmp_path, capsys):
     line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("Compliance"))
     assert line.startswith("Compliance (23.1323): does not comply, ")
     assert "airspeed complies, altimeter does not comply" in line
+
+
+@pytest.mark.parametrize("flag, what", [("--flight", "flight"),
+                                        ("--aircraft", "aircraft file")])
+@pytest.mark.parametrize("out", ["-o", "--json", "--pdf"])
+def test_no_output_on_top_of_any_input(tmp_path, capsys, flag, what, out):
+    res, other = tmp_path / "res.json", tmp_path / "input.file"
+    res.write_text(json.dumps(result_json()))
+    other.write_text("[aircraft]\ntype = 'X'\n")
+    args = ["report", str(res), flag, str(other)]
+    args += ["-o", str(tmp_path / "r.html")] if out != "-o" else []
+    assert main([*args, out, str(other)]) == 2
+    assert f"would overwrite the input {what}" in capsys.readouterr().err
+    assert other.read_text() == "[aircraft]\ntype = 'X'\n"

@@ -78,6 +78,7 @@ def run(args):
     for option, out in (("--json", args.json), ("--plot", args.plot)):
         if out is not None:
             check_output(option, out, source, "flight file")
+            check_output(option, out, args.calibration, "calibration")
     # matplotlib would append ".png" to a figure name without extension: that name counts
     plot_path = None if args.plot is None else \
         args.plot if Path(args.plot).suffix else f"{args.plot}.png"

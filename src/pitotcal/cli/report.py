@@ -51,14 +51,14 @@ def run(args):
 
     choice("regulation", args.regulation, REGULATION_CHOICES)
     source = Path(args.result)
+    # every output against every input: none is ever written over
+    inputs = [(source, "result JSON"), (args.flight, "flight"),
+              (args.aircraft, "aircraft file")]
     for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
-        if out is not None:
-            check_output(option, out, source, "result JSON")
+        for path, what in inputs:
+            if out is not None and path is not None:
+                check_output(option, out, path, what)
     check_distinct({"-o": args.output, "--json": args.json, "--pdf": args.pdf})
-    if args.flight is not None:     # the flight is an input too: never written over
-        for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
-            if out is not None:
-                check_output(option, out, args.flight, "flight")
     options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
     read = {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c)}
     done = make_report(source, args.output, flight_path=args.flight, flight_options=read,
