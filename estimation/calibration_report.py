@@ -333,7 +333,9 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
                 options=None):
     """Read the inputs, write the HTML report (and the JSON / PDF when asked).
 
-    `flight_options` go to `read_flight` (start_s, end_s, oat_k: the reading identify used).
+    `flight_options` are the reading identify used: start_s, end_s, oat_k (`read_flight`),
+    temp_recovery, rh_pct (`core.moist_air.with_static_air`); the re-fit takes the result's
+    model, air-data mode (`air_data`; "incompressible" when it records none) and GPS noise.
 
     Returns
     -------
@@ -344,14 +346,18 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     inputs = [("Result JSON", result_path)]
     flight = ident = None
     if flight_path is not None:
+        from pitotcal.core.moist_air import with_static_air
         from pitotcal.io import read_flight
 
         from .identification import identify
 
         opts = {k: v for k, v in (flight_options or {}).items() if v is not None}
         flight = read_flight(flight_path, opts.pop("start_s", None), opts.pop("end_s", None),
-                             **opts)
+                             oat_k=opts.pop("oat_k", None))
+        # identify's temperature and humidity reading, then its air-data mode: the same fit
+        flight = with_static_air(flight, **opts)
         ident = identify(flight, model=result.get("model", "inverse"),
+                         air=result.get("air_data", "incompressible"),
                          gps_noise_std_mps=result.get("gps_noise_std_mps"))
         inputs.append(("Flight", flight_path))
     rows = ()

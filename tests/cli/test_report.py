@@ -77,3 +77,23 @@ def test_no_output_on_top_of_any_input(tmp_path, capsys, flag, what, out):
     assert main([*args, out, str(other)]) == 2
     assert f"would overwrite the input {what}" in capsys.readouterr().err
     assert other.read_text() == "[aircraft]\ntype = 'X'\n"
+
+
+def test_incompressible_result_reproduced_with_its_air_data(tmp_path):
+    """The re-fit uses the result's air-data mode: an `--air incompressible` result of a flight
+    that has ps_pa and oat_k (a compressible fit would differ) is reproduced, no warning."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    flight, _ = synthetic_flight(seed=6, n=3000, k=(0.02, -15.0), cas_kt=(90.0, 150.0))
+    oat = np.full(flight.n, 288.15)
+    flight = replace(flight, oat_k=oat, ps_pa=flight.rho_kgm3 * 287.05287 * oat)
+    csv, result = tmp_path / "flight.csv", tmp_path / "result.json"
+    write_flight_csv(flight, csv)
+    assert main(["identify", str(csv), "--air", "incompressible", "--no-budget",
+                 "--json", str(result)]) == 0
+    out_json = tmp_path / "r.json"
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(tmp_path / "r.html"),
+                 "--json", str(out_json)]) == 0
+    assert "does not reproduce" not in (tmp_path / "r.html").read_text()
