@@ -13,6 +13,7 @@ import datetime
 import hashlib
 import math
 import tomllib
+import warnings
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
@@ -374,8 +375,13 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     if json_path is not None:
         from pitotcal.io.jsonfile import write_json
 
-        write_json(json_path, {**result, "compliance": context["compliance"]})
+        write_json(json_path, {**result, "warnings": context["warnings"],
+                               "compliance": context["compliance"]})
         written.append(json_path)
     if pdf_path is not None:
         written.append(write_pdf(html_path, pdf_path))
+    # the report's own warnings (the result's were said when it was made), after the files
+    for message in context["warnings"]:
+        if message not in result.get("warnings", []):
+            warnings.warn(message, stacklevel=2)
     return {"compliance": context["compliance"], "written": written}

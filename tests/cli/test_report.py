@@ -97,3 +97,16 @@ def test_incompressible_result_reproduced_with_its_air_data(tmp_path):
     assert main(["report", str(result), "--flight", str(csv), "-o", str(tmp_path / "r.html"),
                  "--json", str(out_json)]) == 0
     assert "does not reproduce" not in (tmp_path / "r.html").read_text()
+
+
+def test_report_warnings_in_json_and_stderr(tmp_path, capsys):
+    res, out_json = tmp_path / "res.json", tmp_path / "r.json"
+    res.write_text(json.dumps(result_json(dv_kt=-1.0)))       # no dv_U_kt: no expanded U
+    assert main(["report", str(res), "-o", str(tmp_path / "r.html"),
+                 "--json", str(out_json)]) == 0
+    written = json.loads(out_json.read_text())["warnings"]
+    assert written[0] == "constructed for a test"            # the result's own, kept
+    assert any("no expanded uncertainty U" in w for w in written)
+    err = capsys.readouterr().err
+    assert "warning: the result has no expanded uncertainty U" in err
+    assert "constructed for a test" not in err               # said by identify already
