@@ -119,7 +119,8 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
     if alt is not None:
         figures.append(("Altimeter correction", _png(alt)))
     if ident is not None and flight is not None:
-        warnings += _reproduces(result, ident)
+        if "points" not in result:      # a legs result is another method: not comparable
+            warnings += _reproduces(result, ident)
         figures.append(("Calibration (paper Figs. 7-8 style), with the residual time history",
                         _png(figs.calibration_png(ident))))
         figures.append(("Ground track and residual distribution", _png(figs.track_png(flight,
@@ -322,10 +323,15 @@ def read_result(path):
         raise PitotcalError(f"{path}: not a JSON file ({exc})") from None
     except UnicodeDecodeError:
         raise PitotcalError(f"{path}: not a JSON file (binary content)") from None
+    if isinstance(doc, dict) and not doc.get("airspeed_correction"):
+        from .legs_report import legs_as_result
+
+        doc = legs_as_result(doc)
     if not isinstance(doc, dict) or not doc.get("airspeed_correction"):
-        raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` "
-                            "(no airspeed_correction table)")
+        raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` or "
+                            "`pitotcal legs --json` (no airspeed_correction table)")
     return doc
+
 
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,

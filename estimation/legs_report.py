@@ -15,8 +15,8 @@ from pitotcal.core.units import KT_TO_MPS
 from .legs import solve_points
 from .legs_global import fit_legs
 
-__all__ = ["POINT_KEYS", "analyze_legs", "flight_legs_json", "flight_legs_text", "legs_json",
-           "legs_summary", "plot_legs"]
+__all__ = ["POINT_KEYS", "analyze_legs", "flight_legs_json", "flight_legs_text",
+           "legs_as_result", "legs_json", "legs_summary", "plot_legs"]
 
 # The keys of each entry of the JSON's "points" list, in order.
 POINT_KEYS = ("point", "ias_kt", "tas_kt", "tas_2sigma_kt", "wind_speed_kt", "wind_from_deg",
@@ -215,3 +215,19 @@ def flight_legs_text(res):
         lines.append(f"  {s.point:<7}{s.ias_kt:6.1f}{s.dv_kt:+9.2f}±{_fmt(s.dv_half_kt, '.2f'):<4}"
                      f"{glob:>14}{float(dv_s):+9.2f}±{float(h_s):.2f}")
     return "\n".join(lines)
+
+
+# the global leg fit's keys shown under the legs table (the rest are the result's own)
+_LEGS_GLOBAL_KEYS = ("model", "wind_mode", "n_samples", "dof", "noise_std_kt", "noise_source")
+
+
+def legs_as_result(doc):
+    """A `pitotcal legs --json` as a report input: its global fit is the result, its points
+    the legs table; a legs JSON without a global fit is returned as it is (and refused)."""
+    glob = doc.get("global")
+    if not isinstance(doc.get("points"), list) or not isinstance(glob, dict):
+        return doc
+    notes = list(doc.get("warnings") or [])
+    notes += [w for w in glob.get("warnings") or [] if w not in notes]
+    return {**glob, "source": doc.get("source"), "warnings": notes, "points": doc["points"],
+            "global": {k: glob[k] for k in _LEGS_GLOBAL_KEYS if k in glob}}

@@ -110,3 +110,24 @@ def test_report_warnings_in_json_and_stderr(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "warning: the result has no expanded uncertainty U" in err
     assert "constructed for a test" not in err               # said by identify already
+
+
+def test_legs_json_is_a_report_input(tmp_path, capsys):
+    """`pitotcal legs --json` gives the report: the global fit as the result, the points as
+    the legs table (docs/legs-example.csv: truth k1 = 0.03, k2 = -40 Pa)."""
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[2] / "docs" / "legs-example.csv"
+    legs_json, html, out_json = tmp_path / "legs.json", tmp_path / "r.html", tmp_path / "r.json"
+    assert main(["legs", str(example), "--json", str(legs_json)]) == 0
+    capsys.readouterr()
+    assert main(["report", str(legs_json), "-o", str(html), "--json", str(out_json)]) == 0
+    text = html.read_text()
+    assert 'id="legs-table"' in text and "4-leg" in text
+    legs = json.loads(legs_json.read_text())
+    out = json.loads(out_json.read_text())
+    assert out["airspeed_correction"] == legs["global"]["airspeed_correction"]
+    assert out["points"] == legs["points"]
+    assert out["compliance"]["airspeed"]["rows"]
+    # the leg file's warnings come with it
+    assert set(legs["warnings"]) <= set(out["warnings"])
