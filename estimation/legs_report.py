@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 
 from pitotcal.core.errors import ObservabilityError
-from pitotcal.core.units import KT_TO_MPS
+from pitotcal.core.units import KT_TO_MPS, m_to_ft
 
 from .legs import solve_points
 from .legs_global import fit_legs
@@ -58,7 +58,7 @@ def _detail(s):
             "tas_subset_sd_kt": s.tas_subset_sd_mps / KT_TO_MPS,
             "naive_average_tas_kt": s.naive_tas_mps / KT_TO_MPS,
             "naive_average_bias_kt": (s.naive_tas_mps - s.tas_mps) / KT_TO_MPS,
-            "pressure_alt_ft": s.pressure_alt_m / 0.3048, "oat_c": s.oat_k - 273.15,
+            "pressure_alt_ft": m_to_ft(s.pressure_alt_m), "oat_c": s.oat_k - 273.15,
             "qc_pa": s.qc_pa, "dp_static_pa": s.qc_pa - s.qci_pa, "vc_kt": s.vc_kt,
             "residuals_kt": list(s.residuals_mps / KT_TO_MPS)}
 
