@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pitotcal.core.errors import ObservabilityError, PitotcalError
+from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import RHO0_KGM3
 
 __all__ = ["MIN_TRACK_SPREAD_DEG", "TOLERANCE", "ParameterRecommendation", "recommend",
@@ -149,9 +150,8 @@ def recommend(flight, autopilot, current=None, *, gps_noise_std_mps=None, name=N
     qref = float(np.median(const.qci_pa))
     k1, k1_sd = const.value("k1"), const.stddev("k1")
     value = _parameter(autopilot, k1, qref, air)
-    h = 1e-6
-    two_sigma = 2.0 * abs(_parameter(autopilot, k1 + h, qref, air)
-                          - _parameter(autopilot, k1 - h, qref, air)) / (2 * h) * k1_sd
+    grad = gradient(lambda k: _parameter(autopilot, k[0], qref, air), [k1])
+    two_sigma = 2.0 * float(band(grad, np.array([[k1_sd ** 2]])))
     _check_bounds(name, value, two_sigma, current, autopilot)
     if current is not None and abs(value - current) <= two_sigma:
         notes.append("the current value is inside the 2 sigma band: the change is not "

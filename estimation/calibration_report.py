@@ -13,6 +13,7 @@ import datetime
 import hashlib
 import math
 import tomllib
+import warnings
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
@@ -118,7 +119,8 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
     if alt is not None:
         figures.append(("Altimeter correction", _png(alt)))
     if ident is not None and flight is not None:
-        warnings += _reproduces(result, ident)
+        if "points" not in result:      # a legs result is another method: not comparable
+            warnings += _reproduces(result, ident)
         figures.append(("Calibration (paper Figs. 7-8 style), with the residual time history",
                         _png(figs.calibration_png(ident))))
         figures.append(("Ground track and residual distribution", _png(figs.track_png(flight,
@@ -321,10 +323,15 @@ def read_result(path):
         raise PitotcalError(f"{path}: not a JSON file ({exc})") from None
     except UnicodeDecodeError:
         raise PitotcalError(f"{path}: not a JSON file (binary content)") from None
+    if isinstance(doc, dict) and not doc.get("airspeed_correction"):
+        from .legs_report import legs_as_result
+
+        doc = legs_as_result(doc)
     if not isinstance(doc, dict) or not doc.get("airspeed_correction"):
-        raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` "
-                            "(no airspeed_correction table)")
+        raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` or "
+                            "`pitotcal legs --json` (no airspeed_correction table)")
     return doc
+
 
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
@@ -333,7 +340,9 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
                 options=None):
     """Read the inputs, write the HTML report (and the JSON / PDF when asked).
 
-    `flight_options` go to `read_flight` (start_s, end_s, oat_k: the reading identify used).
+    `flight_options` are the reading identify used: start_s, end_s, oat_k (`read_flight`),
+    temp_recovery, rh_pct (`core.moist_air.with_static_air`); the re-fit takes the result's
+    model, air-data mode (`air_data`; "incompressible" when it records none) and GPS noise.
 
     Returns
     -------
@@ -344,14 +353,18 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     inputs = [("Result JSON", result_path)]
     flight = ident = None
     if flight_path is not None:
+        from pitotcal.core.moist_air import with_static_air
         from pitotcal.io import read_flight
 
         from .identification import identify
 
         opts = {k: v for k, v in (flight_options or {}).items() if v is not None}
         flight = read_flight(flight_path, opts.pop("start_s", None), opts.pop("end_s", None),
-                             **opts)
+                             oat_k=opts.pop("oat_k", None))
+        # identify's temperature and humidity reading, then its air-data mode: the same fit
+        flight = with_static_air(flight, **opts)
         ident = identify(flight, model=result.get("model", "inverse"),
+                         air=result.get("air_data", "incompressible"),
                          gps_noise_std_mps=result.get("gps_noise_std_mps"))
         inputs.append(("Flight", flight_path))
     rows = ()
@@ -368,8 +381,13 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     if json_path is not None:
         from pitotcal.io.jsonfile import write_json
 
-        write_json(json_path, {**result, "compliance": context["compliance"]})
+        write_json(json_path, {**result, "warnings": context["warnings"],
+                               "compliance": context["compliance"]})
         written.append(json_path)
     if pdf_path is not None:
         written.append(write_pdf(html_path, pdf_path))
+    # the report's own warnings (the result's were said when it was made), after the files
+    for message in context["warnings"]:
+        if message not in result.get("warnings", []):
+            warnings.warn(message, stacklevel=2)
     return {"compliance": context["compliance"], "written": written}

@@ -11,6 +11,8 @@ can be made from a file alone. The requirements (prescriptive text checked for t
 - 14 CFR 23.1325(e): the system error in indicated pressure altitude may not exceed ±30 ft per
   100 kt of speed; applied as ±0.30 ft per KCAS, with no 30 ft floor (29.1325(f) has one; it
   could not be confirmed for 23.1325(e), and the check without it is the stricter one).
+  With 25.1323 the altimeter paragraph is 25.1325's; its text could not be checked here, so
+  the same 23.1325(e) limit is applied (no floor) and the block's title says so.
 
 Part 23 since Amdt. 23-64 (2017) and CS-23 since Amdt. 5 are performance-based: the numbers
 live in the accepted means of compliance (ASTM F3264 and the standards it calls up), which
@@ -47,7 +49,11 @@ REGULATIONS = {
                        "greater",
         "fraction": 0.03, "floor_kt": 5.0},
 }
-ALTIMETER_TITLE = "14 CFR 23.1325(e) static pressure system"
+ALTIMETER_TITLES = {
+    "23.1323": "14 CFR 23.1325(e) static pressure system",
+    "25.1323": ("14 CFR 25.1325 static pressure system (the 23.1325(e) limit applied: "
+                "25.1325's own text, and any ±30 ft floor, not checked here)"),
+}
 ALTIMETER_REQUIREMENT = "altimeter system error at most ±30 ft per 100 kt (±0.30 ft per KCAS)"
 BASIS_NOTE = ("Limits are the prescriptive ones of 14 CFR 23.1323(b)/23.1325(e) (to Amdt. "
               "23-63) and 25.1323(c); for Part 23 Amdt. 23-64+ and CS-23 Amdt. 5+ the accepted "
@@ -93,7 +99,7 @@ def assess(result, regulation="23.1323", speed_range_kt=None):
         The ``compliance`` block of docs/interfaces.md (section "Calibration report"):
         regulation, title, requirement, basis, speed_range_kt, speed_range_source ("flown" or
         "given"), flown_range_kcas, uncertainty ("expanded" or "statistical"), uncertainty_note,
-        verdict (the worst of the airspeed rows), airspeed {verdict, rows}, altimeter {verdict,
+        verdict (the worst of the airspeed and altimeter rows), airspeed {verdict, rows}, altimeter {verdict,
         reason, rows}. Each airspeed row: vi_kt, vc_kt, dv_kt, u_kt, limit_kt, verdict, reason;
         each altimeter row: vc_kt, dh_ft, u_ft, limit_ft, verdict, reason.
     """
@@ -108,7 +114,7 @@ def assess(result, regulation="23.1323", speed_range_kt=None):
     expanded = all(_finite(r.get("dv_U_kt")) for r in rows)
     grid = _grid(rows, lo, hi, flown)
     air = [_airspeed_row(r, reg, expanded) for r in grid]
-    alt = _altimeter(grid, all(_finite(r.get("dh_ft")) for r in rows))
+    alt = _altimeter(grid, all(_finite(r.get("dh_ft")) for r in rows), regulation)
     return {
         "regulation": regulation, "title": reg["title"], "requirement": reg["requirement"],
         "basis": BASIS_NOTE,
@@ -119,7 +125,8 @@ def assess(result, regulation="23.1323", speed_range_kt=None):
                              "uncertainty budget" if expanded else
                              "the result has no expanded uncertainty (dv_U_kt): only the "
                              "statistical 2σ is included, so the verdict is optimistic"),
-        "verdict": _worst(r["verdict"] for r in air),
+        # every row counts: an altimeter that does not comply is not hidden by the airspeed
+        "verdict": _worst(r["verdict"] for r in air + alt["rows"]),
         "airspeed": {"verdict": _worst(r["verdict"] for r in air), "rows": air},
         "altimeter": alt,
     }
@@ -189,9 +196,10 @@ def _airspeed_row(row, reg, expanded):
             "limit_kt": limit, "verdict": verdict, "reason": reason}
 
 
-def _altimeter(grid, has_dh):
+def _altimeter(grid, has_dh, regulation):
+    title = ALTIMETER_TITLES[regulation]
     if not has_dh:
-        return {"title": ALTIMETER_TITLE, "requirement": ALTIMETER_REQUIREMENT,
+        return {"title": title, "requirement": ALTIMETER_REQUIREMENT,
                 "verdict": NOT_DEMONSTRATED, "reason": "no static-source data (dh_ft)",
                 "rows": []}
     rows = []
@@ -211,7 +219,7 @@ def _altimeter(grid, has_dh):
         rows.append({"vc_kt": vc, "dh_ft": r["dh_ft"], "u_ft": u, "limit_ft": limit,
                      "verdict": verdict, "reason": reason})
     verdict = _worst(r["verdict"] for r in rows)
-    return {"title": ALTIMETER_TITLE, "requirement": ALTIMETER_REQUIREMENT, "verdict": verdict,
+    return {"title": title, "requirement": ALTIMETER_REQUIREMENT, "verdict": verdict,
             "reason": "per speed below (u_ft: the statistical 2σ of dh_ft)", "rows": rows}
 
 

@@ -27,11 +27,11 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.errors import ObservabilityError, PitotcalError
-from pitotcal.core.models import get_model
+from pitotcal.core.models import delta_v_kt, get_model
 from pitotcal.core.propagation import band, gradient
-from pitotcal.core.units import KT_TO_MPS, wind_polar
+from pitotcal.core.units import KT_TO_MPS, m_to_ft, wind_polar
 
-__all__ = ["WIND_MODES", "LegFit", "delta_v_compressible_kt", "fit_legs", "wind_groups"]
+__all__ = ["WIND_MODES", "LegFit", "fit_legs", "wind_groups"]
 
 WIND_MODES = ("per-band", "per-point")
 BAND_FT = 1000.0          # width of an altitude band for `per-band` winds
@@ -42,7 +42,7 @@ def wind_groups(legs, mode, band_ft=BAND_FT):
     point by its legs' mean altitude; a band spans `band_ft` up from its lowest point, the next
     begins at the first point above), labelled by the band's mean altitude."""
     points = legs.points()
-    alt_ft = np.array([np.mean(legs.pressure_alt_m[legs.indices(p)]) for p in points]) / 0.3048
+    alt_ft = m_to_ft(np.array([np.mean(legs.pressure_alt_m[legs.indices(p)]) for p in points]))
     if mode == "per-point":
         keys = list(range(len(points)))
     else:
@@ -63,15 +63,6 @@ def wind_groups(legs, mode, band_ft=BAND_FT):
     labels = [f"{np.mean([a for a, k in zip(alt_ft, keys) if k == key]):.0f} ft"
               for key in order]
     return group, labels
-
-
-def delta_v_compressible_kt(model, k, vi_kt):
-    """ΔV_pc = V_c − V_ic, kt, by the standard (compressible) CAS law:
-    q_ci = q_c(V_ic), q_c = q_ci / (1 − f(q_ci)), V_c = V_c(q_c)."""
-    vi = np.asarray(vi_kt, dtype=float) * KT_TO_MPS
-    qci = airdata.qc_from_cas_pa(vi)
-    qc = qci / (1.0 - model(k, qci))
-    return (airdata.cas_from_qc_mps(qc) - vi) / KT_TO_MPS
 
 
 def predicted_tas_mps(model, k, qci_pa, ps_ind_pa, oat_k):
@@ -112,8 +103,9 @@ class LegFit:
         """ΔV (kt) at `vi_kt` and its half-width (`half_width_factor` × σ, delta method)."""
         model = get_model(self.model)
         k = self.coefficients
-        dv = delta_v_compressible_kt(model, k, vi_kt)
-        g = gradient(lambda kk: delta_v_compressible_kt(model, kk, vi_kt), k)
+        # ΔV_pc by the standard (compressible) CAS law, `core.models.delta_v_kt`
+        dv = delta_v_kt(model, k, vi_kt, "compressible")
+        g = gradient(lambda kk: delta_v_kt(model, kk, vi_kt, "compressible"), k)
         return dv, self.half_width_factor * band(g, self.coef_cov)
 
     def correction_table(self, step_kt=None):

@@ -10,13 +10,13 @@ import warnings
 import numpy as np
 
 from pitotcal.core.errors import ObservabilityError
-from pitotcal.core.units import KT_TO_MPS
+from pitotcal.core.units import KT_TO_MPS, m_to_ft
 
 from .legs import solve_points
 from .legs_global import fit_legs
 
-__all__ = ["POINT_KEYS", "analyze_legs", "flight_legs_json", "flight_legs_text", "legs_json",
-           "legs_summary", "plot_legs"]
+__all__ = ["POINT_KEYS", "analyze_legs", "flight_legs_json", "flight_legs_text",
+           "legs_as_result", "legs_json", "legs_summary", "plot_legs"]
 
 # The keys of each entry of the JSON's "points" list, in order.
 POINT_KEYS = ("point", "ias_kt", "tas_kt", "tas_2sigma_kt", "wind_speed_kt", "wind_from_deg",
@@ -58,7 +58,7 @@ def _detail(s):
             "tas_subset_sd_kt": s.tas_subset_sd_mps / KT_TO_MPS,
             "naive_average_tas_kt": s.naive_tas_mps / KT_TO_MPS,
             "naive_average_bias_kt": (s.naive_tas_mps - s.tas_mps) / KT_TO_MPS,
-            "pressure_alt_ft": s.pressure_alt_m / 0.3048, "oat_c": s.oat_k - 273.15,
+            "pressure_alt_ft": m_to_ft(s.pressure_alt_m), "oat_c": s.oat_k - 273.15,
             "qc_pa": s.qc_pa, "dp_static_pa": s.qc_pa - s.qci_pa, "vc_kt": s.vc_kt,
             "residuals_kt": list(s.residuals_mps / KT_TO_MPS)}
 
@@ -215,3 +215,19 @@ def flight_legs_text(res):
         lines.append(f"  {s.point:<7}{s.ias_kt:6.1f}{s.dv_kt:+9.2f}±{_fmt(s.dv_half_kt, '.2f'):<4}"
                      f"{glob:>14}{float(dv_s):+9.2f}±{float(h_s):.2f}")
     return "\n".join(lines)
+
+
+# the global leg fit's keys shown under the legs table (the rest are the result's own)
+_LEGS_GLOBAL_KEYS = ("model", "wind_mode", "n_samples", "dof", "noise_std_kt", "noise_source")
+
+
+def legs_as_result(doc):
+    """A `pitotcal legs --json` as a report input: its global fit is the result, its points
+    the legs table; a legs JSON without a global fit is returned as it is (and refused)."""
+    glob = doc.get("global")
+    if not isinstance(doc.get("points"), list) or not isinstance(glob, dict):
+        return doc
+    notes = list(doc.get("warnings") or [])
+    notes += [w for w in glob.get("warnings") or [] if w not in notes]
+    return {**glob, "source": doc.get("source"), "warnings": notes, "points": doc["points"],
+            "global": {k: glob[k] for k in _LEGS_GLOBAL_KEYS if k in glob}}

@@ -73,7 +73,11 @@ def parse_fault(text, seed=0):
     except ValueError:
         raise PitotcalError(f"fault {text!r}: ONSET_S and SIZE must be numbers",
                             param="fault") from None
-    return check_fault(parts[0], onset, size, seed)
+    try:
+        return check_fault(parts[0], onset, size, seed)
+    except PitotcalError as exc:        # the option's own text, as the user wrote it
+        raise PitotcalError(f"fault {text!r}: {exc}",
+                            param="fault") from None
 
 
 def apply_fault(flight, truth, fault):
@@ -101,6 +105,9 @@ def apply_fault(flight, truth, fault):
         raise PitotcalError("apply_fault needs the truth's history: simulate(..., "
                             "keep_history=True)")
     t = flight.time_s
+    if fault.onset_s >= t[-1]:
+        raise PitotcalError(f"fault onset {fault.onset_s:g} s is at or after the flight's end "
+                            f"({t[-1]:.1f} s): it would never happen", param="fault")
     clean = qci_from_qc_pa(get_model(truth.model), truth.k, truth.history["qc_pa"])
     noise = flight.qci_pa - clean
     after = t >= fault.onset_s

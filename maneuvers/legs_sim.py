@@ -15,7 +15,7 @@ import numpy as np
 from pitotcal.core import airdata
 from pitotcal.core.checks import integer, number
 from pitotcal.core.models import get_model
-from pitotcal.core.units import FT_TO_M, KT_TO_MPS, wind_vector_mps
+from pitotcal.core.units import FT_TO_M, KT_TO_MPS, isa_temperature_k, wind_vector_mps
 from pitotcal.io.legs_csv import LegData
 
 __all__ = ["LEGS_TRUE_K", "LegTruth", "simulate_leg_flight", "simulate_legs"]
@@ -77,7 +77,7 @@ def simulate_legs(ias_kt=(70, 85, 100, 115, 130, 145, 160), tracks_deg=(0, 90, 1
     tracks = np.asarray(tracks_deg, dtype=float)
     alt_m = number("pressure_alt_ft", pressure_alt_ft) * FT_TO_M
     ps = float(airdata.static_pressure_pa(alt_m))
-    oat_k = (288.15 - 0.0065 * alt_m) if oat_c is None else number("oat_c", oat_c) + 273.15
+    oat_k = isa_temperature_k(alt_m) if oat_c is None else number("oat_c", oat_c) + 273.15
     qci = airdata.qc_from_cas_pa(ias * KT_TO_MPS)
     qc = qci / (1.0 - pe(k, qci))
     tas = airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)
@@ -164,7 +164,7 @@ def simulate_leg_flight(ias_kt=(70, 100, 130, 160), headings_deg=(0, 90, 180, 27
     ias = col[:, 2] + frac * (col[:, 3] - col[:, 2])
     alt_m = number("pressure_alt_ft", pressure_alt_ft) * FT_TO_M
     ps = float(airdata.static_pressure_pa(alt_m))
-    oat_k = 288.15 - 0.0065 * alt_m
+    oat_k = isa_temperature_k(alt_m)
     qci = airdata.qc_from_cas_pa(ias * KT_TO_MPS)
     qc = qci / (1.0 - pe(k, qci))
     tas = airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)

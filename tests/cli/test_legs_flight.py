@@ -108,3 +108,30 @@ def test_ulog_legs_detected(tmp_path, capsys):
     d = json.loads(out_json.read_text())
     assert [s["point"] for s in d["segments"]] == [w[2] for w in windows]
     capsys.readouterr()
+
+
+def test_start_end_window_the_flight(flight_csv, tmp_path, capsys):
+    """--start-s/--end-s as identify's: only the legs inside the window are found."""
+    path, _, windows = flight_csv
+    out_json = tmp_path / "r.json"
+    assert main(["legs", str(path), "--start-s", f"{windows[4][0] - 2:g}",
+                 "--end-s", f"{windows[11][1] + 2:g}", "--json", str(out_json)]) == 0
+    d = json.loads(out_json.read_text())
+    assert len(d["segments"]) == 8 and len(d["points"]) == 2     # was 16 legs, 4 points
+    for seg, (t0, t1, _) in zip(d["segments"], windows[4:12]):
+        assert t0 - 2 <= seg["start_s"] < seg["end_s"] <= t1 + 2
+    capsys.readouterr()
+
+
+def test_oat_c_for_a_log(tmp_path, capsys):
+    """--oat-c as identify's: the legs of a log get the OAT given (the leg CSV's oat_c)."""
+    from logwriters import write_ulog
+
+    flight, _, _ = simulate_leg_flight(ias_kt=(80, 120), rate_hz=5.0, seed=2)
+    path = tmp_path / "legs.ulg"
+    write_ulog(path, flight)
+    out_legs = tmp_path / "legs.csv"
+    assert main(["legs", str(path), "--oat-c", "-7.5", "--legs-out", str(out_legs)]) == 0
+    assert np.allclose(read_legs(out_legs).oat_k, 273.15 - 7.5, atol=0.06)
+    assert main(["legs", str(path), "--oat-c", "290"]) == 2
+    assert "--oat-c 290: not an outside air temperature" in capsys.readouterr().err

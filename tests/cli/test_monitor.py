@@ -57,12 +57,22 @@ def test_clean_exit_0(files, capsys):
     (["--calibration", "cal.json", "--false-alarms-per-hour", "0"],
      "--false-alarms-per-hour 0 must be > 0"),
     (["--calibration", "cal.json", "--json", "leak.csv"], "would overwrite the input"),
+    (["--calibration", "cal.json", "--json", "cal.json"],
+     "--json .*cal.json: would overwrite the input calibration"),
+    (["--calibration", "cal.json", "--plot", "x.json"],
+     "--plot .*x.json: unknown figure format 'json'"),
+    (["--calibration", "cal.json", "--warmup-s", "500"],
+     "--warmup-s 500: .*150 s.*nothing left to monitor"),
+    (["--calibration", "cal.json", "--warmup-s", "150"], "--warmup-s 150: "),
 ])
 def test_bad_input_exit_2(files, capsys, args, match):
     import re
     args = [str(files / a) if a.endswith((".csv", ".json")) else a for a in args]
+    before = (files / "cal.json").read_bytes()
     assert main(["monitor", str(files / "leak.csv"), *args]) == 2
-    assert re.search(match, capsys.readouterr().err)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and re.search(match, err[0])
+    assert (files / "cal.json").read_bytes() == before
 
 
 def test_too_short_flight(files, tmp_path, capsys):

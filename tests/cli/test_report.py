@@ -54,3 +54,80 @@ def test_output_on_top_of_input_refused(tmp_path, capsys):
     res.write_text(json.dumps(result_json()))
     assert main(["report", str(res), "-o", str(res)]) == 2
     assert "would overwrite the input result JSON" in capsys.readouterr().err
+
+
+def test_console_verdict_states_airspeed_and_altimeter(tmp_path, capsys):
+    res = tmp_path / "res.json"
+    res.write_text(json.dumps(result_json(dv_kt=-1.0, u_kt=1.0, dh_ft=-40.0)))
+    assert main(["report", str(res), "-o", str(tmp_path / "r.html")]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("Compliance"))
+    assert line.startswith("Compliance (23.1323): does not comply, ")
+    assert "airspeed complies, altimeter does not comply" in line
+
+
+@pytest.mark.parametrize("flag, what", [("--flight", "flight"),
+                                        ("--aircraft", "aircraft file")])
+@pytest.mark.parametrize("out", ["-o", "--json", "--pdf"])
+def test_no_output_on_top_of_any_input(tmp_path, capsys, flag, what, out):
+    res, other = tmp_path / "res.json", tmp_path / "input.file"
+    res.write_text(json.dumps(result_json()))
+    other.write_text("[aircraft]\ntype = 'X'\n")
+    args = ["report", str(res), flag, str(other)]
+    args += ["-o", str(tmp_path / "r.html")] if out != "-o" else []
+    assert main([*args, out, str(other)]) == 2
+    assert f"would overwrite the input {what}" in capsys.readouterr().err
+    assert other.read_text() == "[aircraft]\ntype = 'X'\n"
+
+
+def test_incompressible_result_reproduced_with_its_air_data(tmp_path):
+    """The re-fit uses the result's air-data mode: an `--air incompressible` result of a flight
+    that has ps_pa and oat_k (a compressible fit would differ) is reproduced, no warning."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    flight, _ = synthetic_flight(seed=6, n=3000, k=(0.02, -15.0), cas_kt=(90.0, 150.0))
+    oat = np.full(flight.n, 288.15)
+    flight = replace(flight, oat_k=oat, ps_pa=flight.rho_kgm3 * 287.05287 * oat)
+    csv, result = tmp_path / "flight.csv", tmp_path / "result.json"
+    write_flight_csv(flight, csv)
+    assert main(["identify", str(csv), "--air", "incompressible", "--no-budget",
+                 "--json", str(result)]) == 0
+    out_json = tmp_path / "r.json"
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(tmp_path / "r.html"),
+                 "--json", str(out_json)]) == 0
+    assert "does not reproduce" not in (tmp_path / "r.html").read_text()
+
+
+def test_report_warnings_in_json_and_stderr(tmp_path, capsys):
+    res, out_json = tmp_path / "res.json", tmp_path / "r.json"
+    res.write_text(json.dumps(result_json(dv_kt=-1.0)))       # no dv_U_kt: no expanded U
+    assert main(["report", str(res), "-o", str(tmp_path / "r.html"),
+                 "--json", str(out_json)]) == 0
+    written = json.loads(out_json.read_text())["warnings"]
+    assert written[0] == "constructed for a test"            # the result's own, kept
+    assert any("no expanded uncertainty U" in w for w in written)
+    err = capsys.readouterr().err
+    assert "warning: the result has no expanded uncertainty U" in err
+    assert "constructed for a test" not in err               # said by identify already
+
+
+def test_legs_json_is_a_report_input(tmp_path, capsys):
+    """`pitotcal legs --json` gives the report: the global fit as the result, the points as
+    the legs table (docs/legs-example.csv: truth k1 = 0.03, k2 = -40 Pa)."""
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[2] / "docs" / "legs-example.csv"
+    legs_json, html, out_json = tmp_path / "legs.json", tmp_path / "r.html", tmp_path / "r.json"
+    assert main(["legs", str(example), "--json", str(legs_json)]) == 0
+    capsys.readouterr()
+    assert main(["report", str(legs_json), "-o", str(html), "--json", str(out_json)]) == 0
+    text = html.read_text()
+    assert 'id="legs-table"' in text and "4-leg" in text
+    legs = json.loads(legs_json.read_text())
+    out = json.loads(out_json.read_text())
+    assert out["airspeed_correction"] == legs["global"]["airspeed_correction"]
+    assert out["points"] == legs["points"]
+    assert out["compliance"]["airspeed"]["rows"]
+    # the leg file's warnings come with it
+    assert set(legs["warnings"]) <= set(out["warnings"])

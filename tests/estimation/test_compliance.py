@@ -104,3 +104,22 @@ def test_range_wholly_beyond_flown_has_no_verdict_but_not_demonstrated():
     alt = block["altimeter"]
     assert alt["verdict"] == "not demonstrated"
     assert all("not extrapolated" in r["reason"] for r in alt["rows"])
+
+
+def test_overall_verdict_is_the_worst_of_airspeed_and_altimeter():
+    # airspeed complies (|-1| + 1 < 5 kt), the altimeter does not (40 - 2 > 0.3 ft/KCAS x 69-99)
+    block = assess(result_json(dv_kt=-1.0, u_kt=1.0, dh_ft=-40.0), "23.1323")
+    assert block["airspeed"]["verdict"] == "complies"
+    assert block["altimeter"]["verdict"] == "does not comply"
+    assert block["verdict"] == "does not comply"
+    # straddling altimeter band: the headline is not demonstrated
+    edge = assess(result_json(dv_kt=-1.0, u_kt=1.0, dh_ft=20.0), "23.1323")
+    assert edge["verdict"] == "not demonstrated"
+
+
+def test_transport_regulation_names_its_altimeter_paragraph():
+    part25 = assess(result_json(u_kt=1.0, dh_ft=15.0), "25.1323")["altimeter"]
+    part23 = assess(result_json(u_kt=1.0, dh_ft=15.0), "23.1323")["altimeter"]
+    assert "25.1325" in part25["title"] and "23.1325(e)" in part23["title"]
+    # the 23.1325(e) limit is applied to both (no ±30 ft floor: not confirmed for 25.1325)
+    assert part25["rows"][0]["limit_ft"] == pytest.approx(0.3 * 69.0)

@@ -4,11 +4,11 @@ groups and the refusal of too few legs."""
 import numpy as np
 import pytest
 from pitotcal.estimation.legs import solve_points
-from pitotcal.estimation.legs_global import delta_v_compressible_kt, fit_legs, wind_groups
+from pitotcal.estimation.legs_global import fit_legs, wind_groups
 from pitotcal.maneuvers.legs_sim import LEGS_TRUE_K, simulate_legs
 
 from pitotcal.core.errors import ObservabilityError, PitotcalError
-from pitotcal.core.models import get_model
+from pitotcal.core.models import delta_v_kt, get_model
 
 
 def _start(legs):
@@ -42,8 +42,8 @@ def test_global_band_narrower_than_the_per_point_bounds():
 def test_compressible_delta_v_reduces_to_the_model():
     """ΔV by the CAS law: with k = 0 none; at 100 kt, Δp/q_c = 1 % gives ≈ +0.5 % of V_c."""
     model = get_model("constant")
-    assert abs(delta_v_compressible_kt(model, [0.0], 100.0)) < 1e-12
-    assert delta_v_compressible_kt(model, [0.01], 100.0) == pytest.approx(0.5, rel=0.02)
+    assert abs(delta_v_kt(model, [0.0], 100.0, "compressible")) < 1e-12
+    assert delta_v_kt(model, [0.01], 100.0, "compressible") == pytest.approx(0.5, rel=0.02)
 
 
 def test_to_dict_has_the_identify_form():

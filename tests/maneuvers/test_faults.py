@@ -81,3 +81,26 @@ def test_simulate_fault_option_writes_truth(tmp_path, capsys):
                               "size_unit": "fraction"}
     assert main(["simulate", str(plan_csv), "-o", str(out), "--fault", "leak"]) == 2
     assert "--fault" in capsys.readouterr().err
+
+
+def test_onset_at_or_after_the_end_refused(flown):
+    flight, truth = flown
+    end = float(flight.time_s[-1])
+    for onset in (end, end + 380.0):
+        with pytest.raises(PitotcalError, match=f"onset {onset:g} s is at or after the "
+                                                "flight's end"):
+            apply_fault(flight, truth, Fault("leak", onset, 0.1))
+    assert apply_fault(flight, truth, Fault("leak", end - 1.0, 0.1)).n == flight.n
+
+
+def test_simulate_fault_errors_name_the_option(tmp_path, capsys):
+    plan_csv = write_plan(circle_plan(duration_s=60.0), tmp_path / "plan.csv")
+    out = tmp_path / "f.csv"
+    assert main(["simulate", str(plan_csv), "-o", str(out), "--rate-hz", "5",
+                 "--fault", "leak:500:0.1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--fault" in err[0] and "after the flight's end" in err[0]
+    assert not out.exists()
+    assert main(["simulate", str(plan_csv), "-o", str(out), "--fault", "leak:10:1.5"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--fault 'leak:10:1.5'" in err[0] and "size 1.5" in err[0]

@@ -40,6 +40,19 @@ def check_output(flag, out, source, what):
         raise PitotcalError(f"{flag} {out}: directory {out.parent} does not exist")
 
 
+def check_figure_format(flag, path):
+    """Refuse a figure extension matplotlib cannot write (no extension: PNG), before any work."""
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    from pitotcal.core.errors import PitotcalError
+
+    ext = Path(path).suffix.lower().lstrip(".")
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if ext and ext not in formats:
+        raise PitotcalError(f"{flag} {path}: unknown figure format {ext!r}; use one of "
+                            f"{', '.join(sorted(formats))}")
+
+
 def check_distinct(outputs):
     """Refuse two outputs at one path (hard links included): `outputs` maps flag -> path or
     None (not asked for)."""

@@ -47,6 +47,12 @@ def add_parser(subparsers):
     g.add_argument("--windows", metavar="T0-T1,...|WINDOWS.csv", default=None,
                    help="the legs' time windows, s ('120-180,200-260'), or a CSV with columns "
                         "start_s, end_s and optional point; default: detect steady segments")
+    g.add_argument("--start-s", type=float, default=None, metavar="S",
+                   help="use only samples with time_s >= S")
+    g.add_argument("--end-s", type=float, default=None, metavar="S",
+                   help="use only samples with time_s <= S")
+    g.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
+                   help="logs only: measured outside air temperature, degC (as identify's)")
     for flag, (key, text) in DETECT_FLAGS.items():
         g.add_argument(flag, type=float, default=None, metavar="X",
                        help=f"{text} (default: {_default(key)})")
@@ -102,7 +108,8 @@ def run(args):
     check_distinct({**outputs, "--plot": _plot_path(args)})
     if flight:
         return _run_flight(args, source)
-    given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out")
+    given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out",
+                         "--start-s", "--end-s", "--oat-c")
              if getattr(args, f[2:].replace("-", "_")) is not None]
     if given:
         raise PitotcalError(f"{given[0]}: only for a flight time series; {source} is a leg "
@@ -145,6 +152,7 @@ def _windows(text):
 
 
 def _run_flight(args, source):
+    from pitotcal.cli.common import oat_k_from_c
     from pitotcal.core.checks import number
     from pitotcal.estimation.legs_flight import analyze_leg_flight
     from pitotcal.estimation.legs_report import (
@@ -161,7 +169,8 @@ def _run_flight(args, source):
     tol = 3.0 if args.point_tol_kt is None else number("--point-tol-kt", args.point_tol_kt,
                                                         0.0, 50.0, lo_open=True)
     windows = _windows(args.windows)
-    flight = read_flight(source)
+    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                         oat_k=oat_k_from_c(args.oat_c))
     res = analyze_leg_flight(flight, windows, model=args.model, wind=args.wind,
                              point_tol_kt=tol, **detect)
     wrote = []          # files first, then the summary: a reader that goes away early

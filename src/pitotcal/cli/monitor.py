@@ -60,12 +60,28 @@ def _read_calibration(path):
     return Calibration.from_dict(data, source=str(path))
 
 
+def _check_warmup(flight, warmup_s):
+    """Refuse a warm-up that leaves nothing to monitor (it printed "0 alarm(s)", exit 0)."""
+    from pitotcal.core.errors import PitotcalError
+
+    t0, t1 = float(flight.time_s[0]), float(flight.time_s[-1])
+    if t1 - t0 <= warmup_s:
+        raise PitotcalError(f"--warmup-s {warmup_s:g}: the flight has {t1 - t0:.0f} s "
+                            f"({t0:.1f}-{t1:.1f} s), nothing left to monitor after the warm-up; "
+                            "give a shorter --warmup-s", param="warmup_s")
+
+
 def run(args):
     import json
     import sys
     import warnings
 
-    from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
+    from pitotcal.cli.common import (
+        check_distinct,
+        check_figure_format,
+        check_output,
+        oat_k_from_c,
+    )
     from pitotcal.core.checks import positive
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor import monitor
@@ -78,10 +94,13 @@ def run(args):
     for option, out in (("--json", args.json), ("--plot", args.plot)):
         if out is not None:
             check_output(option, out, source, "flight file")
+            check_output(option, out, args.calibration, "calibration")
     # matplotlib would append ".png" to a figure name without extension: that name counts
     plot_path = None if args.plot is None else \
         args.plot if Path(args.plot).suffix else f"{args.plot}.png"
     check_distinct({"--json": args.json, "--plot": plot_path, "--calibration": None})
+    if args.plot is not None:
+        check_figure_format("--plot", args.plot)
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
                           warmup_s=args.warmup_s).checked()
@@ -90,10 +109,12 @@ def run(args):
                                      idle_timeout_s=positive("idle_s", args.idle_s),
                                      on_status=lambda text: print(text, file=sys.stderr))
         flight = buf.flight()
+        _check_warmup(flight, args.warmup_s)
     else:
         flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
                              oat_k=oat_k_from_c(args.oat_c))
-        result = monitor(flight, cal, opts)
+        result = monitor(flight, cal, opts)      # a flight too short for it is said there
+        _check_warmup(flight, args.warmup_s)
     for message in result.warnings:
         warnings.warn(message, stacklevel=2)
     out = result.to_dict()

@@ -29,6 +29,10 @@ def add_parser(subparsers):
                    help="with --flight: the window identify used (time_s <= S)")
     p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
                    help="with --flight, logs only: the outside air temperature identify used")
+    p.add_argument("--temp-recovery", type=float, default=None, metavar="R",
+                   help="with --flight: the total-temperature recovery factor identify used")
+    p.add_argument("--rh-percent", type=float, default=None, metavar="PCT",
+                   help="with --flight: the relative humidity identify used, %%")
     p.add_argument("--aircraft", metavar="AIRCRAFT.toml", default=None,
                    help="title block: [aircraft] type, registration, configuration, weight, cg; "
                         "[test] date, location, pilot, engineer, notes")
@@ -46,32 +50,37 @@ def add_parser(subparsers):
 
 def run(args):
     from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
-    from pitotcal.core.checks import choice
+    from pitotcal.core.checks import choice, number
     from pitotcal.estimation.calibration_report import make_report
 
     choice("regulation", args.regulation, REGULATION_CHOICES)
     source = Path(args.result)
+    # every output against every input: none is ever written over
+    inputs = [(source, "result JSON"), (args.flight, "flight"),
+              (args.aircraft, "aircraft file")]
     for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
-        if out is not None:
-            check_output(option, out, source, "result JSON")
+        for path, what in inputs:
+            if out is not None and path is not None:
+                check_output(option, out, path, what)
     check_distinct({"-o": args.output, "--json": args.json, "--pdf": args.pdf})
-    if args.flight is not None:     # the flight is an input too: never written over
-        for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
-            if out is not None:
-                check_output(option, out, args.flight, "flight")
     options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
-    read = {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c)}
+    if args.temp_recovery is not None:
+        number("temp_recovery", args.temp_recovery, 0.0, 1.0)
+    if args.rh_percent is not None:
+        number("rh_percent", args.rh_percent, 0.0, 100.0)
+    read = {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c),
+            "temp_recovery": args.temp_recovery, "rh_pct": args.rh_percent}
     done = make_report(source, args.output, flight_path=args.flight, flight_options=read,
                        aircraft_path=args.aircraft, regulation=args.regulation,
                        speed_range_kt=args.speed_range_kt, json_path=args.json,
                        pdf_path=args.pdf, options=options)
-    verdict = done["compliance"].get("verdict")
-    if verdict:
-        print(f"Compliance ({args.regulation}): {verdict}, "
-              f"{done['compliance']['speed_range_kt'][0]:.1f}-"
-              f"{done['compliance']['speed_range_kt'][1]:.1f} KCAS "
-              f"({done['compliance']['speed_range_source']} range; "
-              f"{done['compliance']['uncertainty']} uncertainty)")
+    block = done["compliance"]
+    if block.get("verdict"):
+        print(f"Compliance ({args.regulation}): {block['verdict']}, "
+              f"{block['speed_range_kt'][0]:.1f}-{block['speed_range_kt'][1]:.1f} KCAS "
+              f"({block['speed_range_source']} range; {block['uncertainty']} uncertainty): "
+              f"airspeed {block['airspeed']['verdict']}, "
+              f"altimeter {block['altimeter']['verdict']}")
     for path in done["written"]:
         print(f"Wrote {path}")
     return 0
