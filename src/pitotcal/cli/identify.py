@@ -127,7 +127,12 @@ def run(args):
         return _run_live(args)
     import warnings
 
-    from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
+    from pitotcal.cli.common import (
+        check_distinct,
+        check_figure_format,
+        check_output,
+        oat_k_from_c,
+    )
     from pitotcal.core.checks import choice, number
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -151,7 +156,7 @@ def run(args):
         args.plot if Path(args.plot).suffix else f"{args.plot}.png"
     check_distinct({"--json": args.json, "--plot": plot_path, "--params": args.params})
     if args.plot is not None:
-        _check_plot_format(args.plot)
+        check_figure_format("--plot", args.plot)
 
     number("temp_recovery", args.temp_recovery, 0.0, 1.0)
     if args.rh_percent is not None:
@@ -277,19 +282,6 @@ def _monitor_noise_model(result):
         return {"noise_model": noise_model(result)}
     except PitotcalError:
         return {}
-
-
-def _check_plot_format(path):
-    """Refuse a figure extension matplotlib cannot write (no extension: PNG)."""
-    from matplotlib.backend_bases import FigureCanvasBase
-
-    from pitotcal.core.errors import PitotcalError
-
-    ext = Path(path).suffix.lower().lstrip(".")
-    formats = FigureCanvasBase.get_supported_filetypes()
-    if ext and ext not in formats:
-        raise PitotcalError(f"--plot {path}: unknown figure format {ext!r}; use one of "
-                            f"{', '.join(sorted(formats))}")
 
 
 def _run_live(args):
