@@ -127,54 +127,25 @@ def run(args):
         return _run_live(args)
     import warnings
 
-    from pitotcal.cli.common import (
-        check_distinct,
-        check_figure_format,
-        check_output,
-        oat_k_from_c,
-    )
     from pitotcal.core.checks import choice, number
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
-    from pitotcal.core.moist_air import with_static_air
     from pitotcal.estimation import identify
     from pitotcal.estimation.budget import uncertainty_budget
     from pitotcal.estimation.budget_report import budget_summary
-    from pitotcal.io import is_log_file, read_flight
+    from pitotcal.io import is_log_file
 
     choice("model", args.model, [*MODELS, "auto"])
     choice("air", args.air, AIR_CHOICES)
     if args.gps_noise_mps is not None:
         number("gps_noise_mps", args.gps_noise_mps, 0.0, 10.0, hi_open=True)
     source = Path(args.flight)
-    # an output on top of the input, or one that cannot be written, is said before the work
-    for option, out in (("--json", args.json), ("--plot", args.plot), ("--params", args.params)):
-        if out is not None:
-            check_output(option, out, source, "flight file")
-    # matplotlib would append ".png" to a figure name without extension: write that name
-    plot_path = None if args.plot is None else \
-        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-    check_distinct({"--json": args.json, "--plot": plot_path, "--params": args.params})
-    if args.plot is not None:
-        check_figure_format("--plot", args.plot)
-
+    plot_path = _checked_outputs(args, source)
     number("temp_recovery", args.temp_recovery, 0.0, 1.0)
     if args.rh_percent is not None:
         number("rh_percent", args.rh_percent, 0.0, 100.0)
     inputs = None if args.no_budget else _budget_inputs(args)
-
-    if args.params is None:
-        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
-                             oat_k=oat_k_from_c(args.oat_c))
-    else:
-        from pitotcal.io.param_files import read_flight_and_parameters
-        flight, autopilot, current = read_flight_and_parameters(
-            source, args.start_s, args.end_s, oat_k=oat_k_from_c(args.oat_c))
-        if autopilot is None:
-            raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
-                                "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
-        _check_params_temperature(flight, args.oat_c)
-    flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
+    flight, autopilot, current = _read(args, source)
     result = identify(flight, model=args.model, air=args.air,
                       gps_noise_std_mps=args.gps_noise_mps)
     budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
@@ -210,6 +181,46 @@ def run(args):
     if params is not None:
         _print_params(params, args.params)
     return 0
+
+
+def _checked_outputs(args, source):
+    """Refuse, before the work, an output on the input, two outputs at one path, a folder or
+    a figure format matplotlib cannot write; the figure's path as written (".png" added)."""
+    from pitotcal.cli.common import check_distinct, check_figure_format, check_output
+
+    for option, out in (("--json", args.json), ("--plot", args.plot), ("--params", args.params)):
+        if out is not None:
+            check_output(option, out, source, "flight file")
+    plot_path = None if args.plot is None else \
+        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
+    check_distinct({"--json": args.json, "--plot": plot_path, "--params": args.params})
+    if args.plot is not None:
+        check_figure_format("--plot", args.plot)
+    return plot_path
+
+
+def _read(args, source):
+    """(Flight with static air temperature, autopilot, current parameters): the autopilot
+    and its parameters only with --params (None, {} otherwise)."""
+    from pitotcal.cli.common import oat_k_from_c
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.core.moist_air import with_static_air
+    from pitotcal.io import read_flight
+
+    autopilot, current = None, {}
+    if args.params is None:
+        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                             oat_k=oat_k_from_c(args.oat_c))
+    else:
+        from pitotcal.io.param_files import read_flight_and_parameters
+        flight, autopilot, current = read_flight_and_parameters(
+            source, args.start_s, args.end_s, oat_k=oat_k_from_c(args.oat_c))
+        if autopilot is None:
+            raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
+                                "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
+        _check_params_temperature(flight, args.oat_c)
+    flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
+    return flight, autopilot, current
 
 
 def _check_params_temperature(flight, oat_c):
