@@ -11,7 +11,7 @@ from pitotcal.core.airdata import AIR_DATA_MODES
 from pitotcal.core.errors import FlightDataError, ObservabilityError
 from pitotcal.core.models import MODELS, get_model
 
-from . import robust
+from . import consistency, robust
 from .oe import OutputErrorProblem
 from .unknowns import WIND_INTERNAL
 
@@ -111,7 +111,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     _check_track(flight)
     result, trim_note = _fit_trimmed(flight, functools.partial(
         _identify_any, model=model, gps_noise_std_mps=gps_noise_std_mps,
-        ipopt_options=ipopt_options, air_data=air_data))
+        ipopt_options=ipopt_options, air_data=air_data), air_data)
     # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
     warn = tuple(dict.fromkeys(tuple(flight.warnings) + gate_note + trim_note
                                + tuple(result.warnings) + air_note))
@@ -124,7 +124,7 @@ def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data):
     return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data)
 
 
-def _fit_trimmed(flight, fit):
+def _fit_trimmed(flight, fit, air_data):
     """(result, warnings): the fit, refitted without the samples `robust.outliers` finds.
 
     Up to `_TRIM_ROUNDS` rounds; each refit's residuals are judged again on the kept samples.
@@ -145,13 +145,16 @@ def _fit_trimmed(flight, fit):
                 f"{100 * robust.MAX_TRIM_FRACTION:.0f}%): the data cannot support a calibration; "
                 "look for a leak, a blockage or a bad channel")
         result = fit(flight.select(keep))
+    kept = flight.select(keep) if not keep.all() else flight
+    step_note = consistency.step_test(kept, result, air_data)[0] if result.success else None
+    step_note = (step_note,) if step_note else ()
     if keep.all():
-        return result, ()
+        return result, step_note
     return result, (
         (f"{flight.source}: {int((~keep).sum())} samples trimmed as outliers (residual beyond "
         f"{robust.trim_threshold(flight.n):.1f} sigma of the fitted noise, a false-trim rate of "
         f"{robust.FALSE_TRIM_RATE:g} per flight under Gaussian noise) and the fit repeated "
-        f"without them: {robust.spans_text(flight.time_s, ~keep)}"),)
+        f"without them: {robust.spans_text(flight.time_s, ~keep)}"),) + step_note
 
 
 def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data):

@@ -4,7 +4,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from pitotcal.estimation import identify, robust
+from pitotcal.estimation import consistency, identify, robust
 from synthetic import synthetic_flight
 
 from pitotcal.core.errors import ObservabilityError
@@ -110,3 +110,30 @@ def test_spans_text():
     mask = np.zeros(10, dtype=bool)
     mask[[1, 2, 3, 7]] = True
     assert robust.spans_text(t, mask) == "t = 0.50-1.50 s, 3.50 s"
+
+
+@pytest.fixture(scope="module")
+def calm():
+    return synthetic_flight(seed=1, turbulence_mps=0.3)
+
+
+def test_leak_from_mid_flight_is_named(calm):
+    """q_ci 5 % low from the middle of the record on: a warning naming the onset and size."""
+    flight, _ = calm
+    t_mid = flight.time_s[flight.n // 2]
+    leak = _with(flight, "qci_pa", np.flatnonzero(flight.time_s >= t_mid), lambda v: 0.95 * v)
+    result = _fit(leak)
+    note = [w for w in result.warnings if "changes during the flight" in w]
+    assert len(note) == 1, result.warnings
+    _, details = consistency.step_test(leak, result, "incompressible")
+    assert abs(details["onset_s"] - t_mid) < 0.1 * flight.time_s[-1]
+    assert details["step"] == pytest.approx(0.05, abs=0.025)
+    assert f"t = {details['onset_s']:.0f} s" in note[0]
+
+
+def test_consistent_flight_not_flagged(calm):
+    flight, _ = calm
+    result = _fit(flight)
+    warning, details = consistency.step_test(flight, result, "incompressible")
+    assert warning is None and abs(details["z"]) < details["threshold"]
+    assert details["step"] == pytest.approx(0.0, abs=0.025)
