@@ -31,6 +31,7 @@ _ACCEL_WINDOW_S = 0.5
 FALSE_TRIM_RATE = 0.01
 # More samples beyond the threshold than this is not a few glitches: the noise model is wrong.
 MAX_TRIM_FRACTION = 0.02
+_SPIKE_SAMPLES = 5
 _FLIGHT_NAMES = {"qc_pa": "qci_pa"}     # the CSV's column names -> Flight's
 
 
@@ -119,19 +120,26 @@ def trim_threshold(n, rate=FALSE_TRIM_RATE):
 
 
 def outliers(residuals_pa):
-    """Boolean mask of the residuals beyond `trim_threshold` in units of their robust scale.
+    """Boolean mask of the isolated residual spikes beyond `trim_threshold`.
 
-    The scale is 1.4826 x the median absolute deviation: the fitted noise model's standard
-    deviation, unmoved by the outliers it has to find. Residuals at 50 Hz are correlated, but
-    each is still Gaussian under the noise model, so the per-flight false-trim rate is at most
-    `FALSE_TRIM_RATE` (a union bound).
+    Standardized residual: (r - median r) / (1.4826 x the median absolute deviation), the
+    fitted noise's scale unmoved by the outliers it has to find; Gaussian under the noise
+    model, so the per-flight false-trim rate is at most `FALSE_TRIM_RATE` (a union bound).
+    A sample is trimmed only when it also stands off its `_SPIKE_SAMPLES`-sample running
+    median by half the threshold: the residual of flight is correlated (gusts, GPS error, a
+    curved maneuver), and a sustained excursion is that noise, which the colored-residual
+    covariance counts, not a glitch.
     """
+    from scipy.ndimage import median_filter
+
     r = np.asarray(residuals_pa, dtype=float)
-    centre = np.median(r)
-    scale = 1.4826 * np.median(np.abs(r - centre))
+    dev = np.abs(r - np.median(r))
+    scale = 1.4826 * np.median(dev)
     if not scale > 0:
         return np.zeros(r.size, dtype=bool)
-    return np.abs(r - centre) / scale > trim_threshold(r.size)
+    threshold = trim_threshold(r.size) * scale
+    spike = np.abs(r - median_filter(r, size=_SPIKE_SAMPLES, mode="nearest"))
+    return (dev > threshold) & (spike > 0.5 * threshold)
 
 
 def spans_text(time_s, mask, limit=5):
