@@ -137,3 +137,24 @@ def test_consistent_flight_not_flagged(calm):
     warning, details = consistency.step_test(flight, result, "incompressible")
     assert warning is None and abs(details["z"]) < details["threshold"]
     assert details["step"] == pytest.approx(0.0, abs=0.025)
+
+
+def test_cli_json_names_the_trimmed_samples(clean, tmp_path):
+    """`pitotcal identify`: exit 0, the removal in the JSON `warnings`, truth within 3 sigma."""
+    import json
+
+    from pitotcal.cli import main
+    from pitotcal.io import write_flight_csv
+
+    flight, truth = clean
+    rows = _rows(flight)
+    csv = write_flight_csv(_with(flight, "qci_pa", rows, lambda v: 3.0 * v), tmp_path / "f.csv")
+    out = tmp_path / "r.json"
+    assert main(["identify", str(csv), "--air", "incompressible", "--json", str(out)]) == 0
+    result = json.loads(out.read_text())
+    assert [w for w in result["warnings"] if f"{rows.size} samples trimmed as outliers" in w]
+    for name, true in truth["parameters"].items():
+        p = result["parameters"][name]
+        diff = (p["value"] - true + 180.0) % 360.0 - 180.0 if name == "wind_from_deg" \
+            else p["value"] - true
+        assert abs(diff) < 3 * p["std"], name
