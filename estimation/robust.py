@@ -27,11 +27,11 @@ DENSITY_MARGIN = 0.35
 # window around each sample (the GPS fix's own noise is allowed on top).
 MAX_ACCEL_G = 3.0
 _ACCEL_WINDOW_S = 0.5
-# Trimming: the expected number of clean samples trimmed per flight under Gaussian noise.
+# Trimming: the chance that a clean flight loses any sample, under Gaussian noise (a bound).
 FALSE_TRIM_RATE = 0.01
 # More samples beyond the threshold than this is not a few glitches: the noise model is wrong.
 MAX_TRIM_FRACTION = 0.02
-_SPIKE_SAMPLES = 5
+_SPIKE_SAMPLES = 5           # running median of an isolated spike's neighbours (0.1 s at 50 Hz)
 _FLIGHT_NAMES = {"qc_pa": "qci_pa"}     # the CSV's column names -> Flight's
 
 
