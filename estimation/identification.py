@@ -1,6 +1,7 @@
 """`identify`: the public entry point of the output-error calibration (issue 2, item 3)."""
 
 import dataclasses
+import functools
 import logging
 
 import numpy as np
@@ -10,6 +11,7 @@ from pitotcal.core.airdata import AIR_DATA_MODES
 from pitotcal.core.errors import FlightDataError, ObservabilityError
 from pitotcal.core.models import MODELS, get_model
 
+from . import consistency, robust
 from .oe import OutputErrorProblem
 from .unknowns import WIND_INTERNAL
 
@@ -28,6 +30,7 @@ MAX_CORRELATION = 0.9995
 
 # Problems are cached per (structure, IPOPT options): building costs more than solving.
 _PROBLEMS = {}
+_TRIM_ROUNDS = 3
 
 
 def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
@@ -103,15 +106,55 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     checks.choice("air", air, AIR_DATA_MODES)
     air_data, air_note = _air_data(flight, air)
     _check_flight(flight, air_data)
+    flight, gate_note = robust.gate_flight(flight)
+    _check_flight(flight, air_data)
     _check_track(flight)
-
-    if model == "auto":
-        result = _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data)
-    else:
-        result = _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data)
+    result, trim_note = _fit_trimmed(flight, functools.partial(
+        _identify_any, model=model, gps_noise_std_mps=gps_noise_std_mps,
+        ipopt_options=ipopt_options, air_data=air_data), air_data)
     # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
-    warn = tuple(dict.fromkeys(tuple(flight.warnings) + tuple(result.warnings) + air_note))
+    warn = tuple(dict.fromkeys(tuple(flight.warnings) + gate_note + trim_note
+                               + tuple(result.warnings) + air_note))
     return dataclasses.replace(result, warnings=warn)
+
+
+def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data):
+    if model == "auto":
+        return _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data)
+    return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data)
+
+
+def _fit_trimmed(flight, fit, air_data):
+    """(result, warnings): the fit, refitted without the samples `robust.outliers` finds.
+
+    Up to `_TRIM_ROUNDS` rounds; each refit's residuals are judged again on the kept samples.
+    More than `robust.MAX_TRIM_FRACTION` trimmed is refused: the noise is not the Gaussian
+    the bounds assume, and no trimming threshold makes them honest.
+    """
+    keep = np.ones(flight.n, dtype=bool)
+    result = fit(flight)
+    for _ in range(_TRIM_ROUNDS):
+        out = robust.outliers(result.residuals_pa)
+        if not out.any():
+            break
+        keep[np.flatnonzero(keep)[out]] = False
+        if (~keep).mean() > robust.MAX_TRIM_FRACTION:
+            raise ObservabilityError(
+                f"{flight.source}: {int((~keep).sum())} samples ({100 * (~keep).mean():.1f}%) "
+                f"have residuals beyond {robust.trim_threshold(flight.n):.1f} sigma (more than "
+                f"{100 * robust.MAX_TRIM_FRACTION:.0f}%): the data cannot support a calibration; "
+                "look for a leak, a blockage or a bad channel")
+        result = fit(flight.select(keep))
+    kept = flight.select(keep) if not keep.all() else flight
+    step_note = consistency.step_test(kept, result, air_data)[0] if result.success else None
+    step_note = (step_note,) if step_note else ()
+    if keep.all():
+        return result, step_note
+    return result, (
+        (f"{flight.source}: {int((~keep).sum())} samples trimmed as outliers (residual beyond "
+        f"{robust.trim_threshold(flight.n):.1f} sigma of the fitted noise, a false-trim rate of "
+        f"{robust.FALSE_TRIM_RATE:g} per flight under Gaussian noise) and the fit repeated "
+        f"without them: {robust.spans_text(flight.time_s, ~keep)}"),) + step_note
 
 
 def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data):
