@@ -1,4 +1,5 @@
-"""Helpers the commands share: the --oat-c option and the output checks.
+"""Helpers the commands share: the reading options (--start-s, --end-s, --oat-c) and the
+output checks.
 
 A command module imports from here, never from another command's module.
 """
@@ -8,6 +9,22 @@ from pathlib import Path
 
 # Outside air temperatures anyone calibrates in, degC (ISA at 15 km is -56.5 degC).
 OAT_C_RANGE = (-90.0, 60.0)
+
+def add_reading_arguments(parser, prefix=""):
+    """--start-s, --end-s and --oat-c, with one meaning wherever a flight or log is read.
+
+    `prefix` starts each help text (e.g. "with --flight: ").
+    """
+    parser.add_argument("--start-s", type=float, default=None, metavar="S",
+                        help=f"{prefix}use only samples with time_s >= S (logs: seconds since "
+                             "the log's start)")
+    parser.add_argument("--end-s", type=float, default=None, metavar="S",
+                        help=f"{prefix}use only samples with time_s <= S")
+    parser.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
+                        help=f"{prefix}logs only: measured outside air temperature, degC, for "
+                             "density (default: the log's airspeed or baro sensor temperature, "
+                             "with a warning); a flight CSV carries its own rho_kgm3 or oat_k")
+
 
 def oat_k_from_c(oat_c):
     """--oat-c in kelvin; a PitotcalError naming the option when it is not an OAT in degC."""

@@ -5,6 +5,8 @@ from pathlib import Path
 
 
 def add_parser(subparsers):
+    from pitotcal.cli.common import add_reading_arguments
+
     p = subparsers.add_parser(
         "convert", help="convert a PX4 .ulg or ArduPilot .bin/.log to a flight CSV",
         description="Read a PX4 ULog (.ulg) or ArduPilot DataFlash log (.bin binary, .log text), "
@@ -17,13 +19,7 @@ def add_parser(subparsers):
     p.add_argument("log", metavar="LOG", help="log file: .ulg, .bin or .log")
     p.add_argument("-o", "--output", required=True, metavar="FLIGHT.csv",
                    help="flight CSV to write")
-    p.add_argument("--start-s", type=float, default=None, metavar="S",
-                   help="window start, seconds since log start")
-    p.add_argument("--end-s", type=float, default=None, metavar="S",
-                   help="window end, seconds since log start")
-    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
-                   help="measured outside air temperature, degC, for density (default: the "
-                        "log's airspeed or baro sensor temperature, with a warning)")
+    add_reading_arguments(p)
     p.add_argument("--gps-resample", choices=("linear", "hold"), default="linear",
                    help="GPS onto the pressure times: interpolate between fixes, or hold the "
                         "last fix (default: %(default)s)")

@@ -14,6 +14,8 @@ AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_D
 
 
 def add_parser(subparsers):
+    from pitotcal.cli.common import add_reading_arguments
+
     p = subparsers.add_parser(
         "identify", help="identify the pressure error and the wind from a flight",
         description="Read a flight CSV (or a .ulg/.bin/.log autopilot log), identify the "
@@ -39,14 +41,7 @@ def add_parser(subparsers):
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
-    p.add_argument("--start-s", type=float, default=None, metavar="S",
-                   help="use only samples with time_s >= S")
-    p.add_argument("--end-s", type=float, default=None, metavar="S",
-                   help="use only samples with time_s <= S")
-    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
-                   help="logs only: measured outside air temperature, degC, for density "
-                        "(default: the log's airspeed or baro sensor temperature, with a "
-                        "warning); a flight CSV carries its own rho_kgm3 or oat_k")
+    add_reading_arguments(p)
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")

@@ -24,6 +24,8 @@ DETECT_FLAGS = {
 
 
 def add_parser(subparsers):
+    from pitotcal.cli.common import add_reading_arguments
+
     p = subparsers.add_parser(
         "legs", help="calibrate from GPS legs (3-leg, 4-leg) per point and globally",
         description="Read a leg CSV (one row per constant-speed leg: point, ias_kt, "
@@ -47,12 +49,7 @@ def add_parser(subparsers):
     g.add_argument("--windows", metavar="T0-T1,...|WINDOWS.csv", default=None,
                    help="the legs' time windows, s ('120-180,200-260'), or a CSV with columns "
                         "start_s, end_s and optional point; default: detect steady segments")
-    g.add_argument("--start-s", type=float, default=None, metavar="S",
-                   help="use only samples with time_s >= S")
-    g.add_argument("--end-s", type=float, default=None, metavar="S",
-                   help="use only samples with time_s <= S")
-    g.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
-                   help="logs only: measured outside air temperature, degC (as identify's)")
+    add_reading_arguments(g)
     for flag, (key, text) in DETECT_FLAGS.items():
         g.add_argument(flag, type=float, default=None, metavar="X",
                        help=f"{text} (default: {_default(key)})")

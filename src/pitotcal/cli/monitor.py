@@ -9,6 +9,8 @@ from pathlib import Path
 
 
 def add_parser(subparsers):
+    from pitotcal.cli.common import add_reading_arguments
+
     p = subparsers.add_parser(
         "monitor", help="test a flight's airspeed against a calibration (health monitoring)",
         description="Predict the pitot's q_ci from GPS velocity, the calibration's wind, model "
@@ -27,12 +29,7 @@ def add_parser(subparsers):
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the figure (paper Fig. 15 style)")
-    p.add_argument("--start-s", type=float, default=None, metavar="S",
-                   help="use only samples with time_s >= S")
-    p.add_argument("--end-s", type=float, default=None, metavar="S",
-                   help="use only samples with time_s <= S")
-    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
-                   help="logs only: measured outside air temperature, degC")
+    add_reading_arguments(p)
     p.add_argument("--idle-s", type=float, default=3.0, metavar="S",
                    help="live: the stream has ended after S seconds without a message (3)")
     t = p.add_argument_group("test design")

@@ -10,6 +10,8 @@ REGULATION_CHOICES = ("23.1323", "25.1323", "none")
 
 
 def add_parser(subparsers):
+    from pitotcal.cli.common import add_reading_arguments
+
     p = subparsers.add_parser(
         "report", help="write the calibration report (HTML, optionally PDF) from a result JSON",
         description="Render a self-contained HTML calibration report from the JSON of "
@@ -23,12 +25,7 @@ def add_parser(subparsers):
                    help="the flight the result came from (CSV or log, read with its defaults): "
                         "adds test conditions, the calibration figure with residuals and the "
                         "ground track (the fit is re-run on it and checked against the result)")
-    p.add_argument("--start-s", type=float, default=None, metavar="S",
-                   help="with --flight: the window identify used (time_s >= S)")
-    p.add_argument("--end-s", type=float, default=None, metavar="S",
-                   help="with --flight: the window identify used (time_s <= S)")
-    p.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
-                   help="with --flight, logs only: the outside air temperature identify used")
+    add_reading_arguments(p, "with --flight: ")
     p.add_argument("--temp-recovery", type=float, default=None, metavar="R",
                    help="with --flight: the total-temperature recovery factor identify used")
     p.add_argument("--rh-percent", type=float, default=None, metavar="PCT",
