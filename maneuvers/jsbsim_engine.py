@@ -23,9 +23,9 @@ import math
 import numpy as np
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.units import FT_TO_M, wind_polar, wind_vector_mps
+from pitotcal.core.units import FT_TO_M, wind_vector_mps
 
-__all__ = ["DEFAULT_AIRCRAFT", "GAINS", "JSBSIM_RATE_HZ", "aircraft_names", "fly", "mean_wind",
+__all__ = ["DEFAULT_AIRCRAFT", "GAINS", "JSBSIM_RATE_HZ", "aircraft_names", "fly",
            "milspec_setting", "new_fdm", "set_turbulence", "start"]
 
 DEFAULT_AIRCRAFT = "c172x"
@@ -273,9 +273,3 @@ def fly(fdm, refs, limits, opts, trim, center_deg, steps_per_control):
                             zip(record["lat_deg"], record["lon_deg"])]).T
     record.update(north_m=north, east_m=east, qc_pa=record["pt_pa"] - record["ps_pa"])
     return record, path_index
-
-
-def mean_wind(record):
-    """The time-average of the wind flown through (turbulence included): speed, from-deg."""
-    return tuple(map(float, wind_polar(float(np.mean(record["wind_n_mps"])),
-                                       float(np.mean(record["wind_e_mps"])))))

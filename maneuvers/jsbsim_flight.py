@@ -7,7 +7,7 @@ import tempfile
 import numpy as np
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.models import get_model, qci_from_qc_pa
+from pitotcal.core.models import get_model
 
 from .jsbsim_engine import (
     DEFAULT_AIRCRAFT,
@@ -15,7 +15,6 @@ from .jsbsim_engine import (
     GAINS,
     JSBSIM_RATE_HZ,
     fly,
-    mean_wind,
     new_fdm,
     set_turbulence,
     start,
@@ -104,9 +103,8 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
     """The sensors' records of JSBSim's flight (Flight) and the Truth."""
     from pitotcal.core.flight import Flight
 
-    from .sensors import gps_velocity_sensor, impact_pressure_sensor
-    from .simulator import _tracking
-    from .truth import Truth
+    from .sensors import gps_velocity_sensor, impact_pressure_sensor, static_port_pa
+    from .simulator import _tracking, _truth
 
     rng_qc, rng_gps = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)[1:])
     t, dt = refs.sample_time_s, 1.0 / opts.rate_hz
@@ -118,12 +116,6 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
     gps = gps_velocity_sensor(t, vel, rng_gps, rate_hz=opts.gps_rate_hz,
                               noise_mps=opts.gps_noise_mps, latency_s=opts.gps_latency_s,
                               gm_sigma_mps=opts.gps_gm_sigma_mps, gm_tau_s=opts.gps_gm_tau_s)
-    # the static port reads p_s + Δp_p with all the pressure error in the static source (the
-    # total pressure exact), Δp_p = q_c − q_ci at the probe: as maneuvers.simulator does
-    model = get_model(opts.model)
-    dp = record["qc_pa"] - qci_from_qc_pa(model, tuple(opts.k[:len(model.params)]),
-                                          record["qc_pa"])
-    speed, from_deg = mean_wind(record)
     meta = {"generator": "pitotcal simulate --engine jsbsim", "seed": seed,
             "aircraft": engine["aircraft"], "model": opts.model,
             **dict(zip(get_model(opts.model).params, opts.k)),
@@ -131,7 +123,8 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
             "air_data": "compressible"}
     flight = Flight(time_s=t, qci_pa=qci, gps_vn_mps=gps[:, 0], gps_ve_mps=gps[:, 1],
                     rho_kgm3=record["rho_kgm3"], gps_vd_mps=gps[:, 2], alt_m=record["alt_m"],
-                    ps_pa=record["ps_pa"] + dp, oat_k=record["oat_k"],
+                    ps_pa=static_port_pa(record["ps_pa"], record["qc_pa"], opts.model, opts.k),
+                    oat_k=record["oat_k"],
                     source=f"simulate(engine=jsbsim, seed={seed})", meta=meta)
     states = np.column_stack([record[key] for key in _STATES])
     tracking = _tracking(plan, refs, states, path_index, record["rho_kgm3"])
@@ -139,17 +132,9 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
                 "max_sideslip_deg": float(np.degrees(np.max(np.abs(record["beta_rad"])))),
                 "max_alpha_deg": float(np.degrees(np.max(record["alpha_rad"]))),
                 "stall_warning_s": float(np.sum(record["stall_warning"] > 0) * dt)}
-    wn, we = float(np.mean(record["wind_n_mps"])), float(np.mean(record["wind_e_mps"]))
-    truth = Truth(
-        model=opts.model, k=opts.k,
-        parameters={**dict(zip(get_model(opts.model).params, opts.k)),
-                    "wind_speed_mps": speed, "wind_from_deg": from_deg},
-        wind_n_mps=wn, wind_e_mps=we,
-        wind_mean_process={"speed_mps": opts.wind_speed_mps, "from_deg": opts.wind_from_deg,
-                           "drift_mps2": list(opts.wind_drift_mps2)},
-        seed=seed, options={**opts.to_dict(), **engine, **realised}, tracking=tracking,
-        speed_loop={"gains": dict(GAINS)}, plan=dict(plan.settings or {}),
-        history=(dict(record, time_s=t) if keep_history else None), air_data="compressible")
+    truth = _truth(plan, opts, seed, states, tracking, {"gains": dict(GAINS)},
+                   dict(record, time_s=t) if keep_history else None,
+                   options={**opts.to_dict(), **engine, **realised}, air_data="compressible")
     return flight, truth
 
 

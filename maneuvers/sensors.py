@@ -14,8 +14,15 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model, qci_from_qc_pa
 from pitotcal.core.scenario import true_k
 
-__all__ = ["air_records", "first_order_lag", "gauss_markov", "gps_velocity_sensor", "hold_index",
-           "impact_pressure_sensor"]
+__all__ = [
+    "air_records",
+    "first_order_lag",
+    "gauss_markov",
+    "gps_velocity_sensor",
+    "hold_index",
+    "impact_pressure_sensor",
+    "static_port_pa",
+]
 
 
 def first_order_lag(x, dt_s, tau_s):
@@ -153,6 +160,14 @@ def gps_velocity_sensor(time_s, vel_mps, rng, *, rate_hz=5.0, noise_mps=0.05, la
     return vel[held] + noise[held]
 
 
+def static_port_pa(ps_pa, qc_pa, model="inverse", k=None):
+    """What the static port reads with all the pressure error in the static source: p_s + Δp_p,
+    Δp_p = q_c − q_ci at the probe (the pitot's total pressure exact), before the transducer."""
+    m = get_model(model)
+    k = true_k(model) if k is None else k
+    return ps_pa + qc_pa - qci_from_qc_pa(m, tuple(k[:len(m.params)]), qc_pa)
+
+
 def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
     """The air-data truth and records of `AirSensors` (issue 9): (q_c, logged ρ, columns).
 
@@ -191,11 +206,7 @@ def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
         qc = qc_from_tas_sq_pa(v_probe ** 2, ps, tv)
     else:
         qc = 0.5 * ps / (R_AIR_JKGK * tv) * v_probe ** 2
-    ps_read = ps
-    if air_data == "compressible":
-        m = get_model(model)
-        k = true_k(model) if k is None else k
-        ps_read = ps + qc - qci_from_qc_pa(m, tuple(k[:len(m.params)]), qc)
+    ps_read = static_port_pa(ps, qc, model, k) if air_data == "compressible" else ps
     columns = {"ps_pa": ps_read}
     if sensors.tat_recovery is None:
         logged_t = columns["oat_k"] = ts + sensors.oat_bias_k

@@ -22,7 +22,12 @@ from dataclasses import dataclass
 import numpy as np
 from pitotcal.maneuvers.autopilot import GUIDANCE_GAINS, fly
 from pitotcal.maneuvers.autothrottle import tune_autothrottle
-from pitotcal.maneuvers.sensors import air_records, gps_velocity_sensor, impact_pressure_sensor
+from pitotcal.maneuvers.sensors import (
+    air_records,
+    gps_velocity_sensor,
+    impact_pressure_sensor,
+    static_port_pa,
+)
 from pitotcal.maneuvers.sim_options import MAX_SAMPLES, SimOptions, check_plan, sim_options
 from pitotcal.maneuvers.truth import (
     Tracking,
@@ -38,7 +43,7 @@ from pitotcal.core.checks import integer
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.flight import Flight
 from pitotcal.core.measurement import impact_pressure_pa
-from pitotcal.core.models import get_model, qci_from_qc_pa
+from pitotcal.core.models import get_model
 from pitotcal.core.units import (
     G0_MPS2,
     RHO0_KGM3,
@@ -192,14 +197,10 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
     rho = isa_density_kgm3(alt)
     static = {}
     if opts.air_data == "compressible":
-        # isentropic, at the ISA static pressure and temperature rho is made of; the static
-        # port reads p_s + Δp_p with all the pressure error in the static source (the pitot's
-        # total pressure exact), Δp_p = q_c − q_ci at the probe, before the transducer
+        # isentropic, at the ISA static pressure and temperature rho is made of
         ps, oat = isa_pressure_pa(alt), isa_temperature_k(alt)
         qc = qc_from_tas_sq_pa(tas ** 2, ps, oat)
-        model = get_model(opts.model)
-        dp = qc - qci_from_qc_pa(model, tuple(opts.k[:len(model.params)]), qc)
-        static = {"ps_pa": ps + dp, "oat_k": oat}
+        static = {"ps_pa": static_port_pa(ps, qc, opts.model, opts.k), "oat_k": oat}
     else:
         qc = impact_pressure_pa(rho, tas ** 2)
     air = {}
@@ -255,8 +256,12 @@ def _history(plan, refs, wind, states, flight, qc, vel):
             "gust_mps": np.column_stack([wind.gust_u_mps, wind.gust_v_mps])[::sub]}
 
 
-def _truth(plan, opts, seed, states, tracking, loop, history):
-    """The frozen `Truth`: the true calibration, the wind flown through on average, options."""
+def _truth(plan, opts, seed, states, tracking, speed_loop, history, *, options=None,
+           air_data=None):
+    """The frozen `Truth`: the true calibration, the wind flown through on average, options.
+
+    `speed_loop` is the auto-throttle's description (a dict); `options` and `air_data` default
+    to `opts`'s (the JSBSim engine adds its own and is always compressible)."""
     mean_n, mean_e = float(np.mean(states[:, 6])), float(np.mean(states[:, 7]))
     speed, from_deg = map(float, wind_polar(mean_n, mean_e))
     settings = plan.settings or {}
@@ -267,10 +272,9 @@ def _truth(plan, opts, seed, states, tracking, loop, history):
         wind_n_mps=mean_n, wind_e_mps=mean_e,
         wind_mean_process={"speed_mps": opts.wind_speed_mps, "from_deg": opts.wind_from_deg,
                            "drift_mps2": list(opts.wind_drift_mps2)},
-        seed=seed, options=opts.to_dict(), tracking=tracking,
-        speed_loop={"kp": loop.kp, "ki": loop.ki, "engine_lag_s": loop.engine_lag_s,
-                    "lift_to_drag": loop.lift_to_drag, "trim_tas_mps": loop.trim_tas_mps},
-        plan=dict(settings), history=history, air_data=opts.air_data)
+        seed=seed, options=opts.to_dict() if options is None else options, tracking=tracking,
+        speed_loop=speed_loop, plan=dict(settings), history=history,
+        air_data=opts.air_data if air_data is None else air_data)
 
 
 def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind_from_deg=None,
@@ -354,4 +358,6 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps)
     tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)
     history = _history(plan, refs, wind, states, flight, qc, vel) if keep_history else None
-    return flight, _truth(plan, opts, seed, states, tracking, speed_loop, history)
+    loop = {"kp": speed_loop.kp, "ki": speed_loop.ki, "engine_lag_s": speed_loop.engine_lag_s,
+            "lift_to_drag": speed_loop.lift_to_drag, "trim_tas_mps": speed_loop.trim_tas_mps}
+    return flight, _truth(plan, opts, seed, states, tracking, loop, history)
