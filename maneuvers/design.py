@@ -10,11 +10,14 @@ predicted 2σ of ΔV (pitotcal.core.information) over a low-dimensional parametr
 - the share of the dwell time at the low end against the high end.
 
 Each candidate is scored on a constant-bank circle (the OCP's own starting path) with the
-sandwich covariance of least squares under the Dryden-correlated turbulence residuals; the
+sandwich covariance of least squares under the residual noise `identify` models
+(`pitotcal.core.information.gust_covariance`: the Dryden gust along the path and the GPS
+velocity noise through the wind sensitivities, the transducer's white noise), widened for the
+degrees of freedom of a noise model fitted to one record as `identify` widens its bounds; the
 criterion is the worst (or the mean) 2σ of ΔV over the speed range, taking at each speed the
-larger of the bound `identify` reports (one stationary noise level) and the estimate's actual
-scatter (noise growing with V), so the design cannot buy a smaller reported bound with worse
-coverage. A candidate whose end-level dwells cannot turn 360° at full bank is skipped.
+larger of that reported bound and the estimate's actual scatter (the unwidened sandwich), so
+the design cannot buy a smaller reported bound with worse coverage. A candidate whose
+end-level dwells cannot turn 360° at full bank is skipped.
 """
 
 from dataclasses import dataclass
@@ -26,9 +29,8 @@ from pitotcal.core.errors import PlanInfeasibleError
 from pitotcal.core.information import (
     ResidualNoise,
     delta_v_band_kt,
-    least_squares_covariance,
     qci_sensitivities,
-    residual_covariances,
+    reported_covariance,
 )
 from pitotcal.core.models import get_model
 from pitotcal.core.scenario import true_k
@@ -111,20 +113,16 @@ def predict_band_kt(schedule, heading_rad, wind_ne_mps, noise, vi_kt, *, model="
                     k=None):
     """2σ of ΔV at `vi_kt` predicted for the trajectory: (reported, actual) arrays, kt.
 
-    reported: one stationary turbulence level (what `identify`'s colored covariance reports);
-    actual: turbulence pressure growing with V (the estimate's scatter).
+    reported: what `identify` will report (`core.information.reported_covariance`); actual:
+    the estimate's scatter (the same sandwich, unwidened).
     """
     pe = get_model(model)
     k = true_k(model) if k is None else k
     jac = qci_sensitivities(schedule.tas_mps, heading_rad, schedule.rho_kgm3, pe, k,
                             wind_ne_mps)
     p = len(k)
-    out = []
-    for sigma in residual_covariances(schedule.time_s, schedule.tas_mps, schedule.rho_kgm3,
-                                      noise):
-        cov = least_squares_covariance(jac, sigma)
-        out.append(delta_v_band_kt(pe, k, cov[:p, :p], vi_kt))
-    return tuple(out)
+    return tuple(delta_v_band_kt(pe, k, cov[:p, :p], vi_kt)
+                 for cov in reported_covariance(jac, schedule.time_s, noise))
 
 
 def criterion_value(bands, criterion):

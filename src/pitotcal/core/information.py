@@ -13,6 +13,13 @@ tau = L_u / V), s_i the white part (transducer and GPS noise per grid sample). T
 least squares, so its covariance is the sandwich (J^T J)^-1 J^T Sigma J (J^T J)^-1 - what the
 colored-residual covariance of `estimation` estimates from the residuals after the flight.
 
+`gust_covariance` writes the same residual as `estimation.noise_model` does: a velocity
+disturbance reaching q_ci through the wind sensitivities w_i (the last two columns of J), the
+along-path gust g_i as |w_i| g_i and the GPS velocity noise as white noise of variance
+|w_i|^2 sigma_gps^2, plus the transducer's white noise; `reported_covariance` widens the
+sandwich for the degrees of freedom of a noise model fitted to one record, as `identify` does
+(Student-t at N / tau, `estimation.covariance.student_t_widening`).
+
 numpy only; no import of maneuvers or estimation (layers).
 """
 
@@ -22,9 +29,14 @@ from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 from pitotcal.core.models import delta_v_kt, qci_from_qc_pa
 from pitotcal.core.propagation import band, gradient
 
-__all__ = ["ResidualNoise", "delta_v_band_kt", "least_squares_covariance",
-           "predicted_qci_pa", "qci_sensitivities", "residual_covariance",
-           "residual_covariances"]
+__all__ = ["DOF_TAUS", "ResidualNoise", "delta_v_band_kt", "gust_covariance",
+           "least_squares_covariance", "predicted_qci_pa", "qci_sensitivities",
+           "reported_covariance", "residual_covariance", "residual_covariances",
+           "student_t_widening"]
+
+# Degrees of freedom of a noise model fitted to a record of N samples with correlation time
+# tau (samples): N / (DOF_TAUS tau), as estimation.noise_model.DOF_TAUS.
+DOF_TAUS = 1.0
 
 
 class ResidualNoise:
@@ -88,9 +100,9 @@ def residual_covariance(time_s, tas_mps, rho_kgm3, noise, *, stationary=True):
     The white parts are scaled to the grid spacing dt: a sample on the grid stands for
     dt * rate_hz transducer samples (variance / that count) and for dt * gps_rate_hz GPS fixes.
     `stationary` (default) gives every sample the flight's mean-square gust pressure
-    rho^2 <V^2> sigma_u^2, as the colored-residual covariance of `estimation` assumes (it fits
-    one autocovariance to all residuals): the bounds `identify` will report. False keeps
-    rho^2 V_i^2 sigma_u^2 at each sample: the estimate's actual scatter.
+    rho^2 <V^2> sigma_u^2 (one autocovariance for all residuals, as the estimator's noise model
+    was before its velocity terms); False keeps rho^2 V_i^2 sigma_u^2 at each sample. The
+    design scores with `reported_covariance`.
     """
     both = residual_covariances(time_s, tas_mps, rho_kgm3, noise)
     return both[0] if stationary else both[1]
@@ -132,3 +144,49 @@ def delta_v_band_kt(model, k, cov_k, vi_kt):
     the coefficients' covariance `cov_k`)."""
     g = gradient(lambda kk: delta_v_kt(model, kk, vi_kt), k)
     return 2.0 * band(g, cov_k)
+
+
+def gust_covariance(time_s, wind_sens, noise):
+    """Sigma (N x N, Pa^2) of the q_ci residuals through the wind sensitivities.
+
+    Sigma_ij = |w_i| |w_j| sigma_u^2 exp(-|t_i - t_j| / tau)
+               + delta_ij (s_q^2 / (dt f_q) + |w_i|^2 sigma_gps^2 / (dt f_gps)),
+
+    w_i = d q_ci / d wind at sample i (shape (N, 2), Pa per m/s): the along-path gust changes
+    the airspeed, not the ground velocity; a GPS velocity error in any direction reaches q_ci
+    through w_i . e. The white parts are per grid sample of spacing dt (a sample stands for
+    dt f transducer samples or GPS fixes, at least one).
+    """
+    t = np.asarray(time_s, dtype=float)
+    w = np.sqrt(np.sum(np.asarray(wind_sens, dtype=float) ** 2, axis=1))
+    dt = float(np.median(np.diff(t)))
+    gust = w * noise.turbulence_mps
+    sigma = np.outer(gust, gust) * np.exp(-np.abs(t[:, None] - t[None, :])
+                                           / max(noise.tau_s, 1e-9))
+    white = noise.qc_noise_pa ** 2 / max(dt * noise.rate_hz, 1.0)
+    if noise.gps_rate_hz > 0:
+        white = white + (w * noise.gps_noise_mps) ** 2 / max(dt * noise.gps_rate_hz, 1.0)
+    sigma[np.diag_indices_from(sigma)] += white
+    return sigma
+
+
+def reported_covariance(jac, time_s, noise):
+    """(reported, actual) covariance of theta for the sensitivities `jac` (N, p + 2) on the
+    grid `time_s` under `gust_covariance`: the sandwich (actual: the estimate's scatter) and
+    the sandwich widened by `student_t_widening` at N / (DOF_TAUS tau) degrees of freedom
+    (reported: what `identify` reports, its noise model fitted to the same residuals)."""
+    cov = least_squares_covariance(jac, gust_covariance(time_s, jac[:, -2:], noise))
+    t = np.asarray(time_s, dtype=float)
+    dof = (t[-1] - t[0]) / (DOF_TAUS * max(noise.tau_s, 1e-9))
+    return cov * student_t_widening(dof) ** 2, cov
+
+
+def student_t_widening(dof, z=2.0):
+    """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
+    dof >= 3); 1 for infinite dof. The same expansion as `estimation.covariance`."""
+    if not np.isfinite(dof):
+        return 1.0
+    v = max(float(dof), 3.0)
+    t = (z + (z ** 3 + z) / (4 * v) + (5 * z ** 5 + 16 * z ** 3 + 3 * z) / (96 * v ** 2)
+         + (3 * z ** 7 + 19 * z ** 5 + 17 * z ** 3 - 15 * z) / (384 * v ** 3))
+    return t / z
