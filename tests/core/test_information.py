@@ -99,3 +99,14 @@ def test_reported_covariance_is_the_sandwich_widened_for_the_records_correlation
         jac, gust_covariance(t, jac[:, -2:], noise)), rtol=1e-12)
     np.testing.assert_allclose(reported, actual * student_t_widening(119.0 / 6.0) ** 2,
                                rtol=1e-12)
+
+
+def test_ar1_times_is_the_dense_kernel_product():
+    from pitotcal.core.information import ar1_times
+
+    rng = np.random.default_rng(3)
+    for span, tau in ((240.0, 7.0), (3000.0, 2.0)):        # the second crosses stretches
+        t = np.sort(rng.uniform(0.0, span, 700))
+        x = rng.normal(size=(700, 3))
+        dense = np.exp(-np.abs(t[:, None] - t[None, :]) / tau) @ x
+        np.testing.assert_allclose(ar1_times(t, tau, x), dense, rtol=1e-9, atol=1e-9)
