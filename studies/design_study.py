@@ -41,6 +41,9 @@ CHECK_PROFILES = ("continuous", "step-pause")
 EMULATED_DRAWS = 100
 EMULATE_MIN_RUNS = 5
 DURATIONS_S = (150.0, 180.0, 210.0, 240.0)
+# the information bound also below the times flown: without ramps it reaches two-speed's 240-s
+# value sooner
+BOUND_DURATIONS_S = (90.0, 120.0) + DURATIONS_S
 QUICK_DURATIONS_S = (240.0,)
 _GRID = np.linspace(*RANGE_KT, 7)
 
@@ -102,7 +105,8 @@ def information_bound_kt(duration_s, accel_max_mps2=None):
     two-level schedule (`maneuvers.design.design_schedule` without a check level: 2 to
     MAX_DWELLS dwells at 70 and 100 KCAS, any share of time at each end) on the T-2 circle,
     speed changes at `accel_max_mps2` (default: the T-2 limit, 1 m/s²; 1e3: without ramps), kt,
-    and the design (order, share at the low end)."""
+    and the design (order, share at the low end); Nones when no schedule turns 360° at each
+    end in this time."""
     from pitotcal.maneuvers.design import (
         ORDERS,
         alternating_orders,
@@ -110,19 +114,22 @@ def information_bound_kt(duration_s, accel_max_mps2=None):
         design_schedule,
     )
 
-    from pitotcal.core.scenario import T2_PLAN
+    from pitotcal.core.errors import PlanInfeasibleError
+    from pitotcal.core.scenario import T2_PLAN as p
     from pitotcal.core.units import kt_to_mps, wind_vector_mps
 
-    p = T2_PLAN
-    d = design_schedule(
-        p["cas_min_kt"], p["cas_max_kt"], float(duration_s), altitude_m=p["altitude_m"],
-        accel_max_mps2=accel_max_mps2 or 1.0, dt_s=1.0,
-        bank_max_rad=np.radians(p["bank_max_deg"]), radius_m=p["radius_m"],
-        wind_ne_mps=wind_vector_mps(p["wind_speed_mps"], p["wind_from_deg"]),
-        noise=default_noise(TURBULENCE_MPS, p["altitude_m"],
-                            [kt_to_mps(0.5 * (p["cas_min_kt"] + p["cas_max_kt"]))]),
-        coverage_rad=2 * np.pi + np.radians(15.0), range_kt=RANGE_KT, check_fraction=0.0,
-        orders=ORDERS + alternating_orders())
+    noise = default_noise(TURBULENCE_MPS, p["altitude_m"],
+                          [kt_to_mps(0.5 * (p["cas_min_kt"] + p["cas_max_kt"]))])
+    try:
+        d = design_schedule(
+            p["cas_min_kt"], p["cas_max_kt"], float(duration_s), altitude_m=p["altitude_m"],
+            accel_max_mps2=accel_max_mps2 or 1.0, dt_s=1.0,
+            bank_max_rad=np.radians(p["bank_max_deg"]), radius_m=p["radius_m"],
+            wind_ne_mps=wind_vector_mps(p["wind_speed_mps"], p["wind_from_deg"]), noise=noise,
+            coverage_rad=2 * np.pi + np.radians(15.0), range_kt=RANGE_KT, check_fraction=0.0,
+            orders=ORDERS + alternating_orders())
+    except PlanInfeasibleError:                 # too short to turn 360° at each end
+        return None, None, None
     return d.predicted_2sigma_kt, "-".join("LCH"[j] for j in d.order), d.low_share
 
 
@@ -133,13 +140,14 @@ def bound_summary(reference_predicted_kt):
     outside the times planned)."""
     out = {}
     for accel, key in ((1.0, "bound"), (1e3, "bound_no_ramps")):
-        bounds = {str(int(t)): information_bound_kt(t, accel) for t in DURATIONS_S}
+        bounds = {str(int(t)): information_bound_kt(t, accel) for t in BOUND_DURATIONS_S}
         at_240 = bounds[str(int(REFERENCE[1]))]
-        out[f"{key}_kt"] = {t: round(b[0], 3) for t, b in bounds.items()}
+        out[f"{key}_kt"] = {t: round(b[0], 3) for t, b in bounds.items() if b[0]}
         out[f"{key}_design_at_240s"] = list(at_240[1:])
         out[f"{key}_gain_at_240s"] = round(1.0 - at_240[0] / reference_predicted_kt, 3)
         out[f"{key}_time_to_reference_s"] = _time_to(
-            {t: {"predicted_kt": b[0]} for t, b in bounds.items()}, reference_predicted_kt)
+            {t: {"predicted_kt": v} for t, v in out[f"{key}_kt"].items()},
+            reference_predicted_kt)
     return out
 
 
