@@ -235,11 +235,12 @@ def plot(rows, summary, out_dir):
 def figure(summary):
     """Median worst-row 2σ of ΔV vs flight time (flown, with the median's standard error, and
     predicted, with the information bound), and the coverage of ±2σ, per design."""
-    fig, ax = new_figure(1, 2, size=(5.0, 3.8))
+    fig, ax = new_figure(1, 2, size=(5.0, 4.6))
     for (design, entries), marker in zip(summary["by_design"].items(), "Dos^v"):
         t = np.array(sorted(float(k) for k in entries))
         e = [entries[str(int(x))] for x in t]
-        shift = {"optimal": -2.0, "optimal-2-level": 2.0}.get(design, 0.0)   # bars apart
+        shift = {"optimal": -2.0, "optimal-2-level": 2.0, "continuous": 4.0,
+                 "step-pause": 6.0}.get(design, 0.0)                       # bars apart
         bar = ax[0, 0].errorbar(t + shift, _nan([x["dv_2sigma_range_kt"] for x in e]),
                                 yerr=_nan([x.get("dv_2sigma_range_se_kt") for x in e]),
                                 fmt=marker + "-", capsize=2, label=f"{design} (flown)")
@@ -262,7 +263,9 @@ def figure(summary):
     ax[0, 1].axhspan(90, 98, color="0.9")
     for a in ax.flat:
         a.set_xlabel("flight time, s")
-        a.legend(fontsize=7)
+    ax[0, 1].legend(fontsize=7)
+    fig.legend(*ax[0, 0].get_legend_handles_labels(), loc="outside lower center", ncol=4,
+               fontsize=7)
     fig.suptitle(f"Optimal design vs two-speed, {summary['turbulence_mps']:g} m/s turbulence")
     return fig
 

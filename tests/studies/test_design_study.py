@@ -12,16 +12,20 @@ def test_design_study_full_size(tmp_path):
     for design, entries in summary["by_design"].items():
         at_240 = entries["240"]
         assert 0.88 <= at_240["coverage"] <= 1.0, (design, at_240)
-        # identify's median reported bound against the prediction (30 two-speed seeds: 1.16)
-        assert 0.8 < at_240["dv_2sigma_range_kt"] / at_240["predicted_kt"] < 1.5
-        # no schedule beats the ideal two-point bound by more than the seeds' scatter
-        assert at_240["predicted_kt"] >= 0.97 * at_240["ideal_bound_kt"]
-    gain = summary["optimal-2-level_gain_at_240s"]
-    if gain <= -0.1:
-        # measured 2026-11-23: -0.143 at 20 seeds, -0.073 at 60 (docs/measured.md); the
-        # design's one-level Dryden information model predates the estimator's multi-time-scale
-        # noise model, and aligning them is open work (issue 13)
-        pytest.xfail(f"two-level design {gain:+.3f} against two-speed in the reported bound")
+        # identify's median reported bound against the design's prediction (measured 0.94-1.18
+        # at 20 seeds, 0.91-1.08 at 60) and against identify's own covariance on drawn
+        # residuals (0.89-0.99 at 20 seeds)
+        assert 0.8 < at_240["dv_2sigma_range_kt"] / at_240["predicted_kt"] < 1.3, design
+        assert 0.75 < at_240["dv_2sigma_range_kt"] / at_240["emulated_kt"] < 1.25, design
+    bound = summary["information_bound"]
+    # the issue's target (15% below two-speed at 240 s, or its value in 75% of the time) lies
+    # beyond the information bound at the T-2 acceleration limit: 5.4%, 219 s
+    assert bound["bound_gain_at_240s"] < 0.15
+    assert bound["bound_time_to_reference_s"] > 0.75 * 240.0
+    for design in ("optimal", "optimal-2-level"):
+        assert summary["by_design"][design]["240"]["predicted_kt"] >= bound["bound_kt"]["240"]
+        # flown, no design beats the bound by more than the paired ratio's 20-seed scatter
+        assert summary[f"{design}_gain_at_240s"] < bound["bound_gain_at_240s"] + 0.1, design
 
 
 def test_information_bound_caps_the_gain_at_the_acceleration_limit():
