@@ -75,7 +75,7 @@ _LOW_SHARES = np.round(np.arange(0.25, 0.76, 0.05), 2)
 # a speed change every few tau lets the difference of neighbouring dwells cancel the slow part
 # of the gust; each change costs a ramp. On the scoring circle they gain 1.5% at 1 m/s²; on the
 # OCP's path, whose bank follows the ground speed in the wind, the T-2 design with them came out
-# 5-10% worse than without (dwells too short to turn evenly). Shares near a half only.
+# 4-11% worse than without (dwells too short to turn evenly). Shares near a half only.
 MAX_DWELLS = 12
 _ALT_SHARES = (0.45, 0.5, 0.55)
 
