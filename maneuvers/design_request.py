@@ -185,8 +185,11 @@ def _meet_target(run, duration, design, target_kt):
         try:
             duration, design = guess, run(guess)
         except PlanInfeasibleError:
-            # too short to turn at each end: the shortest that can, meets the target a fortiori
+            # too short to turn at each end: the shortest that can (10-s steps) meets the
+            # target a fortiori
             duration = guess + 10.0
+            while not _designs(run, duration):
+                duration += 10.0
             design = run(duration)
     while design.predicted_2sigma_kt > target_kt:
         duration += max(1.0, round(0.01 * duration))

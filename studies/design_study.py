@@ -7,9 +7,12 @@ model; the score is the worst 2σ of ΔV that `identify` reports over 72-98 KIAS
 truth lies inside ±2σ there (coverage). A replicate uses the same seed for every design and
 time (common random numbers).
 
-Beside the flights, the information bound (pitotcal.core.information) of each case, and of
-the ideal two-point design (speed changes without ramps, the best share of time at each
-end): what no schedule of this flight time can beat under the noise model.
+Beside the flights: the design's prediction of the reported bound of each case
+(`maneuvers.design.predict_plan_band_kt`), identify's own covariance run on residuals drawn
+from the same noise model (`design_reported`), for continuous and step-pause too; and the
+information bound: the best two-level schedule of this flight time (any dwell order, any share
+of time at each end) under the noise model, with speed changes at the acceleration limit and
+without ramps - what no schedule can beat.
 """
 
 import numpy as np
@@ -28,8 +31,19 @@ DESIGNS = {
     "two-speed": {"profile": "two-speed"},
     "optimal": {"design": "optimal"},
     "optimal-2-level": {"design": "optimal", "design_options": {"check_fraction": 0.0}},
+    "continuous": {"profile": "continuous"},
+    "step-pause": {"profile": "step-pause"},
 }
+# flown at 240 s only: the check of the prediction on the paper's other profiles
+CHECK_PROFILES = ("continuous", "step-pause")
+# residual draws of the emulated reported bound; cases flown fewer times than EMULATE_MIN_RUNS
+# (lean runs) skip it
+EMULATED_DRAWS = 100
+EMULATE_MIN_RUNS = 5
 DURATIONS_S = (150.0, 180.0, 210.0, 240.0)
+# the information bound also below the times flown: without ramps it reaches two-speed's 240-s
+# value sooner
+BOUND_DURATIONS_S = (90.0, 120.0) + DURATIONS_S
 QUICK_DURATIONS_S = (240.0,)
 _GRID = np.linspace(*RANGE_KT, 7)
 
@@ -53,12 +67,16 @@ def task(seed, design, duration_s):
 
 def cases(runs, quick):
     durations = QUICK_DURATIONS_S if quick else DURATIONS_S
-    designs = ("optimal",) if quick else [d for d in DESIGNS if d != REFERENCE[0]]
+    designs = ("optimal",) if quick else [d for d in DESIGNS
+                                          if d != REFERENCE[0] and d not in CHECK_PROFILES]
     out = []
     for r in range(runs):
         out.append({"design": REFERENCE[0], "duration_s": REFERENCE[1], "seed_offset": r})
         out += [{"design": d, "duration_s": t, "seed_offset": r}
                 for d in designs for t in durations]
+        if not quick:
+            out += [{"design": d, "duration_s": REFERENCE[1], "seed_offset": r}
+                    for d in CHECK_PROFILES]
     return out
 
 
@@ -72,31 +90,65 @@ def predicted_kt(design, duration_s):
     return float(predict_plan_band_kt(plan, TURBULENCE_MPS, _GRID)[0].max())
 
 
-def ideal_bound_kt(duration_s):
-    """The worst-row bounds of the ideal two-point design (instantaneous speed changes, one
-    dwell at each end of 70-100 KCAS, on the T-2 circle), at the best share of time at the low
-    end: (robust, reported-only) kt. Robust: the design criterion, the larger of the reported
-    bound and the actual scatter at each speed. Reported-only: the smallest bound identify
-    could report, reached by a share at which the high-speed scatter exceeds it."""
-    from pitotcal.maneuvers.design import circle_heading_rad, default_noise, predict_band_kt
-    from pitotcal.maneuvers.profiles import dwell_schedule
+def emulated_kt(design, duration_s, draws=EMULATED_DRAWS):
+    """(median, mean) worst-row 2σ of ΔV that identify's covariance reports on residuals drawn
+    from the design's noise model on the case's planned path (`design_reported`)."""
+    from .common import get_plan
+    from .design_reported import emulated_reported_kt
 
-    from pitotcal.core.scenario import T2_PLAN
-    from pitotcal.core.units import kt_to_mps, incompressible_qc_pa, wind_vector_mps
+    plan = get_plan(**plan_kwargs(design, duration_s))
+    return emulated_reported_kt(plan, TURBULENCE_MPS, _GRID, draws=draws)
 
-    q = [float(incompressible_qc_pa(kt_to_mps(T2_PLAN[name]))) for name in ("cas_min_kt",
-                                                                       "cas_max_kt")]
-    wind = wind_vector_mps(T2_PLAN["wind_speed_mps"], T2_PLAN["wind_from_deg"])
-    robust, reported = np.inf, np.inf
-    for share in np.arange(0.3, 0.71, 0.02):
-        s = dwell_schedule(q, [share, 1 - share], duration_s, altitude_m=T2_PLAN["altitude_m"],
-                           accel_max_mps2=1e3)
-        noise = default_noise(TURBULENCE_MPS, T2_PLAN["altitude_m"], s.tas_mps)
-        heading = circle_heading_rad(s, np.radians(25.0))
-        rep, act = predict_band_kt(s, heading, wind, noise, _GRID)
-        robust = min(robust, float(np.maximum(rep, act).max()))
-        reported = min(reported, float(rep.max()))
-    return robust, reported
+
+def information_bound_kt(duration_s, accel_max_mps2=None):
+    """The information bound: the least predicted worst-row 2σ of ΔV over 72-98 KIAS of any
+    two-level schedule (`maneuvers.design.design_schedule` without a check level: 2 to
+    MAX_DWELLS dwells at 70 and 100 KCAS, any share of time at each end) on the T-2 circle,
+    speed changes at `accel_max_mps2` (default: the T-2 limit, 1 m/s²; 1e3: without ramps), kt,
+    and the design (order, share at the low end); Nones when no schedule turns 360° at each
+    end in this time."""
+    from pitotcal.maneuvers.design import (
+        ORDERS,
+        alternating_orders,
+        default_noise,
+        design_schedule,
+    )
+
+    from pitotcal.core.errors import PlanInfeasibleError
+    from pitotcal.core.scenario import T2_PLAN as p
+    from pitotcal.core.units import kt_to_mps, wind_vector_mps
+
+    noise = default_noise(TURBULENCE_MPS, p["altitude_m"],
+                          [kt_to_mps(0.5 * (p["cas_min_kt"] + p["cas_max_kt"]))])
+    try:
+        d = design_schedule(
+            p["cas_min_kt"], p["cas_max_kt"], float(duration_s), altitude_m=p["altitude_m"],
+            accel_max_mps2=accel_max_mps2 or 1.0, dt_s=1.0,
+            bank_max_rad=np.radians(p["bank_max_deg"]), radius_m=p["radius_m"],
+            wind_ne_mps=wind_vector_mps(p["wind_speed_mps"], p["wind_from_deg"]), noise=noise,
+            coverage_rad=2 * np.pi + np.radians(15.0), range_kt=RANGE_KT, check_fraction=0.0,
+            orders=ORDERS + alternating_orders())
+    except PlanInfeasibleError:                 # too short to turn 360° at each end
+        return None, None, None
+    return d.predicted_2sigma_kt, "-".join("LCH"[j] for j in d.order), d.low_share
+
+
+def bound_summary(reference_predicted_kt):
+    """The information bound at each flight time, at the acceleration limit ("bound") and
+    without ramps ("bound_no_ramps"): the best design at 240 s, its gain over two-speed's
+    prediction at 240 s, and the flight time at which it reaches that prediction (None
+    outside the times planned)."""
+    out = {}
+    for accel, key in ((1.0, "bound"), (1e3, "bound_no_ramps")):
+        bounds = {str(int(t)): information_bound_kt(t, accel) for t in BOUND_DURATIONS_S}
+        at_240 = bounds[str(int(REFERENCE[1]))]
+        out[f"{key}_kt"] = {t: round(b[0], 3) for t, b in bounds.items() if b[0]}
+        out[f"{key}_design_at_240s"] = list(at_240[1:])
+        out[f"{key}_gain_at_240s"] = round(1.0 - at_240[0] / reference_predicted_kt, 3)
+        out[f"{key}_time_to_reference_s"] = _time_to(
+            {t: {"predicted_kt": v} for t, v in out[f"{key}_kt"].items()},
+            reference_predicted_kt)
+    return out
 
 
 def summarize(rows, cases=None):
@@ -111,13 +163,17 @@ def summarize(rows, cases=None):
                                            if len(good) > 1 else None),
                  "coverage": _mean(column(good, "dv_inside_range")),
                  "dv_err_max_kt_rms": _rms(column(good, "dv_err_max_kt")),
+                 "mean_2sigma_range_kt": _mean(two_sigma),
                  "predicted_kt": round(predicted_kt(design, duration), 3)}
-        entry["ideal_bound_kt"], entry["ideal_reported_only_kt"] = (
-            round(v, 3) for v in ideal_bound_kt(duration))
+        if len(good) >= EMULATE_MIN_RUNS:
+            entry["emulated_kt"], entry["emulated_mean_kt"] = (
+                round(v, 3) for v in emulated_kt(design, duration))
         by_design.setdefault(design, {})[str(int(duration))] = entry
     ref = by_design.get(REFERENCE[0], {}).get(str(int(REFERENCE[1])), {})
     out = {"by_design": by_design, "range_kt": list(RANGE_KT),
            "turbulence_mps": TURBULENCE_MPS, "reference": ref}
+    if ref:
+        out["information_bound"] = bound_summary(ref["predicted_kt"])
     for design, entries in by_design.items():
         for duration, entry in entries.items():
             entry["paired_ratio"] = _paired_ratio(rows, design, float(duration))
@@ -165,8 +221,11 @@ def headline(summary):
     gain = summary.get("optimal_gain_at_240s")
     reach = summary.get("optimal_time_to_reference_s")
     reach_text = f"{reach:.0f} s" if reach else "outside the times flown"
+    bound = summary.get("information_bound", {}).get("bound_gain_at_240s")
+    bound_text = f"; information bound {bound:.0%} below two-speed" if bound is not None else ""
     return (f"at 240 s optimal {opt:.2f} kt vs two-speed {ref:.2f} kt worst-row 2σ of ΔV over "
-            f"72-98 KIAS ({gain:+.0%} gain); two-speed's value reached in {reach_text}")
+            f"72-98 KIAS ({gain:+.0%} gain); two-speed's value reached in {reach_text}"
+            f"{bound_text}")
 
 
 def plot(rows, summary, out_dir):
@@ -175,12 +234,13 @@ def plot(rows, summary, out_dir):
 
 def figure(summary):
     """Median worst-row 2σ of ΔV vs flight time (flown, with the median's standard error, and
-    predicted, with the ideal bound), and the coverage of ±2σ, per design."""
-    fig, ax = new_figure(1, 2, size=(5.0, 3.8))
-    for (design, entries), marker in zip(summary["by_design"].items(), "Dos"):
+    predicted, with the information bound), and the coverage of ±2σ, per design."""
+    fig, ax = new_figure(1, 2, size=(5.0, 4.6))
+    for (design, entries), marker in zip(summary["by_design"].items(), "Dos^v"):
         t = np.array(sorted(float(k) for k in entries))
         e = [entries[str(int(x))] for x in t]
-        shift = {"optimal": -2.0, "optimal-2-level": 2.0}.get(design, 0.0)   # bars apart
+        shift = {"optimal": -2.0, "optimal-2-level": 2.0, "continuous": 4.0,
+                 "step-pause": 6.0}.get(design, 0.0)                       # bars apart
         bar = ax[0, 0].errorbar(t + shift, _nan([x["dv_2sigma_range_kt"] for x in e]),
                                 yerr=_nan([x.get("dv_2sigma_range_se_kt") for x in e]),
                                 fmt=marker + "-", capsize=2, label=f"{design} (flown)")
@@ -189,11 +249,12 @@ def figure(summary):
                       color=color, label=f"{design} (predicted)")
         ax[0, 1].plot(t, 100 * _nan([x["coverage"] for x in e]), marker + "-", label=design,
                       color=color)
-    bound = dict(sorted((float(k), v["ideal_bound_kt"]) for d in summary["by_design"].values()
-                        for k, v in d.items()))
-    if len(bound) > 1:
-        ax[0, 0].plot(list(bound), list(bound.values()), "k--", lw=0.8,
-                      label="ideal two-point bound")
+    bounds = summary.get("information_bound", {})
+    for key, style, label in (("bound_kt", "k--", "information bound (1 m/s² ramps)"),
+                              ("bound_no_ramps_kt", "k:", "information bound (no ramps)")):
+        if key in bounds:
+            pts = sorted((float(t), v) for t, v in bounds[key].items())
+            ax[0, 0].plot(*zip(*pts), style, lw=0.8, label=label)
     ref = summary["reference"].get("dv_2sigma_range_kt")
     if ref:
         ax[0, 0].axhline(ref, color="0.6", lw=0.6, ls="-.", label="two-speed at 240 s")
@@ -202,7 +263,9 @@ def figure(summary):
     ax[0, 1].axhspan(90, 98, color="0.9")
     for a in ax.flat:
         a.set_xlabel("flight time, s")
-        a.legend(fontsize=7)
+    ax[0, 1].legend(fontsize=7)
+    fig.legend(*ax[0, 0].get_legend_handles_labels(), loc="outside lower center", ncol=4,
+               fontsize=7)
     fig.suptitle(f"Optimal design vs two-speed, {summary['turbulence_mps']:g} m/s turbulence")
     return fig
 

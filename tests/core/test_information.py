@@ -57,3 +57,56 @@ def test_delta_v_band_matches_a_monte_carlo_of_k():
     draws = np.random.default_rng(1).multivariate_normal(k, cov, 4000)
     dv = np.array([delta_v_kt(model, d, vi) for d in draws])
     np.testing.assert_allclose(band, 2 * dv.std(axis=0), rtol=0.05)
+
+
+def test_gust_covariance_is_the_along_path_gust_and_gps_noise_through_the_wind_sensitivities():
+    from pitotcal.core.information import gust_covariance
+
+    t = np.arange(0.0, 20.0, 0.5)
+    psi = np.linspace(0.0, 3.0, t.size)
+    w = np.column_stack([-50.0 * np.cos(psi), -50.0 * np.sin(psi)])     # |w| = 50 Pa per m/s
+    noise = ResidualNoise(turbulence_mps=0.5, tau_s=4.0, qc_noise_pa=1.0, rate_hz=50.0,
+                          gps_noise_mps=0.1, gps_rate_hz=5.0)
+    sigma = gust_covariance(t, w, noise)
+    lag = np.abs(t[:, None] - t[None, :])
+    # the gust's sign does not depend on the heading: |w_i||w_j|, not w_i . w_j
+    expected = 2500.0 * 0.25 * np.exp(-lag / 4.0)
+    expected[np.diag_indices_from(expected)] += 1.0 / 25.0 + 2500.0 * 0.01 / 2.5
+    np.testing.assert_allclose(sigma, expected, rtol=1e-12)
+
+
+def test_student_t_widening_is_the_t_quantile():
+    from scipy.stats import norm, t
+
+    from pitotcal.core.information import student_t_widening
+
+    for dof in (3.0, 5.0, 10.0, 34.0, 200.0):
+        exact = t.ppf(norm.cdf(2.0), dof) / 2.0
+        assert abs(student_t_widening(dof) / exact - 1.0) < 0.01, dof
+    assert student_t_widening(np.inf) == 1.0
+
+
+def test_reported_covariance_is_the_sandwich_widened_for_the_records_correlation_times():
+    from pitotcal.core.information import gust_covariance, reported_covariance, student_t_widening
+
+    t = np.arange(0.0, 120.0, 1.0)
+    psi = 0.1 * t
+    jac = np.column_stack([np.full(t.size, -900.0), np.ones(t.size), -50.0 * np.cos(psi),
+                           -50.0 * np.sin(psi)])
+    noise = ResidualNoise(turbulence_mps=0.5, tau_s=6.0)
+    reported, actual = reported_covariance(jac, t, noise)
+    np.testing.assert_allclose(actual, least_squares_covariance(
+        jac, gust_covariance(t, jac[:, -2:], noise)), rtol=1e-12)
+    np.testing.assert_allclose(reported, actual * student_t_widening(119.0 / 6.0) ** 2,
+                               rtol=1e-12)
+
+
+def test_ar1_times_is_the_dense_kernel_product():
+    from pitotcal.core.information import ar1_times
+
+    rng = np.random.default_rng(3)
+    for span, tau in ((240.0, 7.0), (3000.0, 2.0)):        # the second crosses stretches
+        t = np.sort(rng.uniform(0.0, span, 700))
+        x = rng.normal(size=(700, 3))
+        dense = np.exp(-np.abs(t[:, None] - t[None, :]) / tau) @ x
+        np.testing.assert_allclose(ar1_times(t, tau, x), dense, rtol=1e-9, atol=1e-9)

@@ -13,6 +13,13 @@ tau = L_u / V), s_i the white part (transducer and GPS noise per grid sample). T
 least squares, so its covariance is the sandwich (J^T J)^-1 J^T Sigma J (J^T J)^-1 - what the
 colored-residual covariance of `estimation` estimates from the residuals after the flight.
 
+`gust_covariance` writes the same residual as `estimation.noise_model` does: a velocity
+disturbance reaching q_ci through the wind sensitivities w_i (the last two columns of J), the
+along-path gust g_i as |w_i| g_i and the GPS velocity noise as white noise of variance
+|w_i|^2 sigma_gps^2, plus the transducer's white noise; `reported_covariance` widens the
+sandwich for the degrees of freedom of a noise model fitted to one record, as `identify` does
+(Student-t at N / tau, `estimation.covariance.student_t_widening`).
+
 numpy only; no import of maneuvers or estimation (layers).
 """
 
@@ -22,9 +29,25 @@ from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 from pitotcal.core.models import delta_v_kt, qci_from_qc_pa
 from pitotcal.core.propagation import band, gradient
 
-__all__ = ["ResidualNoise", "delta_v_band_kt", "least_squares_covariance",
-           "predicted_qci_pa", "qci_sensitivities", "residual_covariance",
-           "residual_covariances"]
+__all__ = [
+    "DOF_TAUS",
+    "ResidualNoise",
+    "ar1_times",
+    "delta_v_band_kt",
+    "gust_covariance",
+    "least_squares_covariance",
+    "predicted_qci_pa",
+    "qci_sensitivities",
+    "reported_covariance",
+    "residual_covariance",
+    "residual_covariances",
+    "sandwich",
+    "student_t_widening",
+]
+
+# Degrees of freedom of a noise model fitted to a record of N samples with correlation time
+# tau (samples): N / (DOF_TAUS tau), as estimation.noise_model.DOF_TAUS.
+DOF_TAUS = 1.0
 
 
 class ResidualNoise:
@@ -62,24 +85,34 @@ def predicted_qci_pa(theta, gps_vn, gps_ve, rho_kgm3, model):
 def qci_sensitivities(tas_mps, heading_rad, rho_kgm3, model, k, wind_ne_mps):
     """J = d q_ci / d theta, theta = (k..., wind_n, wind_e), shape (N, p + 2), Pa per unit.
 
-    Central differences of the measurement model at the ground velocity of the planned
-    trajectory (air velocity at `heading_rad` plus the wind).
+    Implicit differentiation of the measurement model q_ci = q_c (1 - f(k, q_ci)) at the
+    ground velocity of the planned trajectory (air velocity at `heading_rad` plus the wind),
+    q_c = rho |V_g - W|^2 / 2:
+
+        d q_ci / d k_i = -q_c df/dk_i / D,   d q_ci / d W = (1 - f) (-rho (V_g - W)) / D,
+        D = 1 + q_c df/dq_ci,
+
+    f's own derivatives by central differences (one solve of the fixed point, not one per
+    unknown). V_g - W is the air velocity, so `wind_ne_mps` does not enter; it names the
+    trajectory's wind for the reader and for `predicted_qci_pa`'s theta.
     """
     tas = np.asarray(tas_mps, dtype=float)
     psi = np.asarray(heading_rad, dtype=float)
-    vn = tas * np.cos(psi) + wind_ne_mps[0]
-    ve = tas * np.sin(psi) + wind_ne_mps[1]
-    theta = np.r_[np.asarray(k, dtype=float), np.asarray(wind_ne_mps, dtype=float)]
+    k = np.asarray(k, dtype=float)
+    qc = impact_pressure_pa(rho_kgm3, tas ** 2)
+    qci = qci_from_qc_pa(model, k, qc)
+    f = model(k, qci)
+    h = 1e-6 * qci
+    denom = 1.0 + qc * (model(k, qci + h) - model(k, qci - h)) / (2.0 * h)
     cols = []
-    for i in range(theta.size):
-        h = 1e-4 * max(abs(theta[i]), 1e-2 if i < theta.size - 2 else 1.0)
-        up, dn = theta.copy(), theta.copy()
-        up[i] += h
-        dn[i] -= h
-        cols.append((predicted_qci_pa(up, vn, ve, rho_kgm3, model)
-                     - predicted_qci_pa(dn, vn, ve, rho_kgm3, model))
-                    / (2 * h))
-    return np.column_stack(cols)
+    for i in range(k.size):
+        step = 1e-6 * max(abs(k[i]), 1e-2)
+        up, dn = k.copy(), k.copy()
+        up[i] += step
+        dn[i] -= step
+        cols.append(-qc * (model(up, qci) - model(dn, qci)) / (2.0 * step) / denom)
+    gain = (1.0 - f) / denom * rho_kgm3 * tas
+    return np.column_stack(cols + [-gain * np.cos(psi), -gain * np.sin(psi)])
 
 
 def residual_covariance(time_s, tas_mps, rho_kgm3, noise, *, stationary=True):
@@ -88,9 +121,9 @@ def residual_covariance(time_s, tas_mps, rho_kgm3, noise, *, stationary=True):
     The white parts are scaled to the grid spacing dt: a sample on the grid stands for
     dt * rate_hz transducer samples (variance / that count) and for dt * gps_rate_hz GPS fixes.
     `stationary` (default) gives every sample the flight's mean-square gust pressure
-    rho^2 <V^2> sigma_u^2, as the colored-residual covariance of `estimation` assumes (it fits
-    one autocovariance to all residuals): the bounds `identify` will report. False keeps
-    rho^2 V_i^2 sigma_u^2 at each sample: the estimate's actual scatter.
+    rho^2 <V^2> sigma_u^2 (one autocovariance for all residuals, as the estimator's noise model
+    was before its velocity terms); False keeps rho^2 V_i^2 sigma_u^2 at each sample. The
+    design scores with `reported_covariance`.
     """
     both = residual_covariances(time_s, tas_mps, rho_kgm3, noise)
     return both[0] if stationary else both[1]
@@ -119,11 +152,16 @@ def residual_covariances(time_s, tas_mps, rho_kgm3, noise):
 def least_squares_covariance(jac, sigma):
     """Covariance of the least-squares estimate with residual covariance `sigma`:
     (J^T J)^-1 J^T Sigma J (J^T J)^-1, columns scaled for conditioning."""
+    return sandwich(jac, jac.T @ sigma @ jac)
+
+
+def sandwich(jac, middle):
+    """(J^T J)^-1 M (J^T J)^-1 for M = J^T Sigma J given, columns scaled for conditioning."""
     scale = np.sqrt(np.sum(jac ** 2, axis=0))
     scale[scale == 0] = 1.0
     js = jac / scale
     inv = np.linalg.pinv(js.T @ js)
-    cov = inv @ (js.T @ sigma @ js) @ inv
+    cov = inv @ (middle / np.outer(scale, scale)) @ inv
     return cov / np.outer(scale, scale)
 
 
@@ -132,3 +170,85 @@ def delta_v_band_kt(model, k, cov_k, vi_kt):
     the coefficients' covariance `cov_k`)."""
     g = gradient(lambda kk: delta_v_kt(model, kk, vi_kt), k)
     return 2.0 * band(g, cov_k)
+
+
+def gust_covariance(time_s, wind_sens, noise):
+    """Sigma (N x N, Pa^2) of the q_ci residuals through the wind sensitivities.
+
+    Sigma_ij = |w_i| |w_j| sigma_u^2 exp(-|t_i - t_j| / tau)
+               + delta_ij (s_q^2 / (dt f_q) + |w_i|^2 sigma_gps^2 / (dt f_gps)),
+
+    w_i = d q_ci / d wind at sample i (shape (N, 2), Pa per m/s): the along-path gust changes
+    the airspeed, not the ground velocity; a GPS velocity error in any direction reaches q_ci
+    through w_i . e. The white parts are per grid sample of spacing dt (a sample stands for
+    dt f transducer samples or GPS fixes, at least one).
+    """
+    gust, white = _gust_parts(time_s, wind_sens, noise)
+    sigma = np.outer(gust, gust) * _ar1_kernel(time_s, noise.tau_s)
+    sigma[np.diag_indices_from(sigma)] += white
+    return sigma
+
+
+def _gust_parts(time_s, wind_sens, noise):
+    """(|w| sigma_u, white variance) per sample of `gust_covariance`."""
+    t = np.asarray(time_s, dtype=float)
+    w = np.sqrt(np.sum(np.asarray(wind_sens, dtype=float) ** 2, axis=1))
+    dt = float(np.median(np.diff(t)))
+    white = noise.qc_noise_pa ** 2 / max(dt * noise.rate_hz, 1.0)
+    if noise.gps_rate_hz > 0:
+        white = white + (w * noise.gps_noise_mps) ** 2 / max(dt * noise.gps_rate_hz, 1.0)
+    return w * noise.turbulence_mps, white * np.ones_like(w)
+
+
+def _ar1_kernel(time_s, tau_s):
+    """exp(-|t_i - t_j| / tau), N x N."""
+    t = np.asarray(time_s, dtype=float)
+    return np.exp(-np.abs(t[:, None] - t[None, :]) / max(tau_s, 1e-9))
+
+
+def ar1_times(time_s, tau_s, x):
+    """K @ x for K = exp(-|t_i - t_j| / tau) on increasing `time_s`, x of shape (N, p), in
+    O(N p): the causal and the anti-causal exponential sums (K x = F + B - x), each a
+    cumulative sum scaled by exp(t / tau) in stretches of at most 50 tau (no overflow)."""
+    s = np.asarray(time_s, dtype=float) / max(tau_s, 1e-9)
+    x = np.asarray(x, dtype=float)
+    return _causal(s, x) + _causal(-s[::-1], x[::-1])[::-1] - x
+
+
+def _causal(s, x):
+    """F_i = sum_(j <= i) exp(-(s_i - s_j)) x_j for increasing s."""
+    out = np.empty_like(x)
+    edges = np.flatnonzero(np.diff(np.floor((s - s[0]) / 50.0))) + 1
+    carry, last = np.zeros(x.shape[1:]), s[0]
+    for a, b in zip(np.r_[0, edges], np.r_[edges, s.size]):
+        e = np.exp(s[a:b] - s[a])[:, None]
+        terms = e * x[a:b]
+        terms[0] += carry * np.exp(-(s[a] - last))      # what came before the stretch
+        out[a:b] = np.cumsum(terms, axis=0) / e
+        carry, last = out[b - 1], s[b - 1]
+    return out
+
+
+def reported_covariance(jac, time_s, noise):
+    """(reported, actual) covariance of theta for the sensitivities `jac` (N, p + 2) on the
+    grid `time_s` under `gust_covariance`: the sandwich (actual: the estimate's scatter) and
+    the sandwich widened by `student_t_widening` at N / (DOF_TAUS tau) degrees of freedom
+    (reported: what `identify` reports, its noise model fitted to the same residuals)."""
+    gust, white = _gust_parts(time_s, jac[:, -2:], noise)
+    x = jac * gust[:, None]
+    cov = sandwich(jac, x.T @ ar1_times(time_s, noise.tau_s, x)
+                   + (jac * white[:, None]).T @ jac)
+    t = np.asarray(time_s, dtype=float)
+    dof = (t[-1] - t[0]) / (DOF_TAUS * max(noise.tau_s, 1e-9))
+    return cov * student_t_widening(dof) ** 2, cov
+
+
+def student_t_widening(dof, z=2.0):
+    """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
+    dof >= 3); 1 for infinite dof. The same expansion as `estimation.covariance`."""
+    if not np.isfinite(dof):
+        return 1.0
+    v = max(float(dof), 3.0)
+    t = (z + (z ** 3 + z) / (4 * v) + (5 * z ** 5 + 16 * z ** 3 + 3 * z) / (96 * v ** 2)
+         + (3 * z ** 7 + 19 * z ** 5 + 17 * z ** 3 - 15 * z) / (384 * v ** 3))
+    return t / z
