@@ -98,7 +98,7 @@ def lag_weights(lag, window="bartlett"):
 
 
 def colored_covariance(jac, residuals, *, window="multiscale", lag=None, information=None,
-                       instruments=None, velocity=None):
+                       instruments=None, velocity=None, known_velocity=None):
     """Covariance corrected for colored residuals (Morelli & Klein 1997; SIDPAC `colores`).
 
     Parameters
@@ -119,6 +119,9 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     velocity : ndarray, shape (N, 2), optional
         The residual's sensitivities to a velocity disturbance (the wind columns of S): with
         "multiscale", GPS velocity error and gusts enter as u . d, modulated by the heading.
+    known_velocity : (float, float), optional
+        (sigma_mps, tau_samples) of a stated Gauss-Markov GPS velocity error per component
+        (`noise_model.fit_multiscale`); "multiscale" with `velocity` only.
 
     Returns
     -------
@@ -144,7 +147,8 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     a, dof, step, h_vel = 0.0, float("inf"), 1, None
     if window == "multiscale":
         from .noise_model import multiscale_acov
-        h, h_vel, step, a, dof = multiscale_acov(residuals, jac, velocity)
+        fit, a, dof = multiscale_acov(residuals, jac, velocity, known_velocity)
+        h, h_vel, step = fit.h, fit.h_vel, fit.step
         lag = (h.size - 1) * step
     elif window == "exponential":
         h, lag, a, dof = _exponential_acov(residuals, jac)

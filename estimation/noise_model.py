@@ -31,27 +31,41 @@ DENSE_LAGS = 16
 LOG_LAGS = 48
 
 
+# Longest correlation time fitted per kind, as a fraction of the longest lag fitted (a quarter
+# of the record). Noise in the pressure itself (along-path gusts: Dryden L/V of 3-13 s, the
+# transducer) decorrelates within seconds; only a velocity error (the GPS receiver's slow
+# drift) is slow. A slow pressure term is mostly projected away by the fit, so the non-negative
+# fit took one up from the wiggles of the sample autocovariance: on 40 JSBSim flights in 1 m/s
+# turbulence a 46 s term appeared in half of them and the k1/k2 bounds came out 1.35x too wide
+# (rms z 0.74 / 0.70; 0.88 / 0.84 with the ensemble autocovariance of the true noise). Pressure
+# terms up to a sixteenth of the record (15 s of 240 s): 0.82 / 0.77 (docs/measured.md).
+TAU_MAX_FRACTION = {"pressure": 0.25, "velocity": 1.0}
+
 # Degrees of freedom of the fitted model's long-run variance (Student-t widening): one per
-# long-run-weighted correlation time in the record. Measured on 60 flights per case (GPS 0.5 m/s
-# + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
-# module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
-# Gauss-Markov case at 85% coverage.
-DOF_TAUS = 1.0
+# DOF_TAUS long-run-weighted correlation times. Measured on 40 flights per case (own simulator
+# GPS 0.5 m/s + 0.5 m/s turbulence and 1 m/s turbulence, JSBSim 1 m/s): with the limits above,
+# DOF_TAUS = 1 left k1/k2 1.05-1.25x too wide, no widening at all gave the rms z of the true
+# noise's autocovariance; a quarter keeps a small widening for short records.
+DOF_TAUS = 0.25
 
 
-def multiscale_acov(residuals, jac, velocity=None):
-    """(h, h_vel, step, a, dof) for `covariance.colored_covariance`: the block-mean
-    autocovariances of `fit_multiscale`, a = exp(-1 / tau) of its long-run-weighted
-    correlation time tau (samples), dof = N / (DOF_TAUS tau). White residuals (lag-1
-    correlation within sampling noise of 0) give h = [R(0)] at full rate."""
+def multiscale_acov(residuals, jac, velocity=None, known=None):
+    """(fit, a, dof) for `covariance.colored_covariance`: the `MultiscaleFit` (block-mean
+    autocovariances), a = exp(-1 / tau) of its long-run-weighted correlation time tau
+    (samples), dof = N / (DOF_TAUS tau). White residuals (lag-1 correlation within sampling
+    noise of 0) and no known term give h = [R(0)] at full rate.
+
+    `known`: (sigma_mps, tau_samples) of a stated Gauss-Markov GPS velocity error, each
+    component (`fit_multiscale`)."""
     n, p = jac.shape
     acov = residual_acf(residuals, 1) * n / max(n - p, 1)
-    if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
-        return acov[:1], None, 1, float(acov[1] / acov[0]), float("inf")
-    fit = fit_multiscale(residuals, jac, velocity)
+    if acov[1] <= 3.0 * acov[0] / np.sqrt(n) and (known is None or velocity is None):
+        fit = MultiscaleFit(acov[:1], None, 1, [], float(acov[0]))
+        return fit, float(acov[1] / acov[0]), float("inf")
+    fit = fit_multiscale(residuals, jac, velocity, known)
     tau = fit.tau_samples
     a = float(np.exp(-1.0 / tau)) if tau > 0 else 0.0
-    return fit.h, fit.h_vel, fit.step, a, (n / (DOF_TAUS * tau) if tau > 0 else float("inf"))
+    return fit, a, (n / (DOF_TAUS * tau) if tau > 0 else float("inf"))
 
 
 class MultiscaleFit:
@@ -59,16 +73,18 @@ class MultiscaleFit:
     and `h_vel` of a velocity disturbance d (GPS velocity error, gusts) that reaches the
     residual as u . d, u the wind sensitivities; and their summary numbers."""
 
-    def __init__(self, h, h_vel, step, terms, white):
+    def __init__(self, h, h_vel, step, terms, white, known_lrv=0.0):
         self.h, self.h_vel, self.step = h, h_vel, step
-        self.terms, self.white = terms, white   # [(kind, tau in blocks, amplitude)]
+        self.terms, self.white = terms, white   # [(kind, tau in blocks, amplitude, gain)]
+        self.known_lrv = known_lrv              # long-run variance of the stated term, Pa^2
 
     @property
     def tau_samples(self):
-        """Long-run-variance-weighted correlation time, samples (0 for white noise)."""
+        """Long-run-variance-weighted correlation time of the fitted terms, samples (0 for
+        white noise); a stated term counts in the total but is not uncertain."""
         lrv = np.array([2.0 * a * t * g for _, t, a, g in self.terms])
         taus = np.array([t for _, t, _, _ in self.terms])
-        total = self.white + lrv.sum()
+        total = self.white + lrv.sum() + self.known_lrv
         return float(self.step * (lrv * taus).sum() / total) if total > 0 else 0.0
 
     def describe(self):
@@ -86,11 +102,15 @@ def block_means(x, step):
     return x[: m * step].reshape(m, step, *x.shape[1:]).mean(axis=1)
 
 
-def fit_multiscale(residuals, jac, velocity=None):
+def fit_multiscale(residuals, jac, velocity=None, known=None):
     """The `MultiscaleFit` of `residuals` at the sensitivities `jac` (N, p).
 
     `velocity` (N, 2): the residual's sensitivities to a velocity disturbance (the wind
-    columns of `jac`); None: pressure-domain terms only.
+    columns of `jac`); None: pressure-domain terms only. `known` (sigma_mps, tau_samples): a
+    Gauss-Markov velocity error stated by the user (the GPS receiver's), autocovariance
+    sigma^2 exp(-|k| / tau) per component; what it puts into the residuals is taken out of
+    their autocovariance before the fit, and it enters h_vel as it is. A slow GPS error
+    looks like wind: the residuals barely show it, so only a statement can count it.
     """
     n, p = jac.shape
     step = max(1, int(np.ceil(n / BLOCK_SAMPLES)))
@@ -111,19 +131,27 @@ def fit_multiscale(residuals, jac, velocity=None):
     for kind, mod in (("pressure", None), ("velocity", ub)):
         if kind == "velocity" and ub is None:
             continue
-        for tau in taus:
+        for tau in taus[taus <= TAU_MAX_FRACTION[kind] * kmax]:
             cols.append(basis(np.exp(-np.arange(_span(tau, m) + 1) / tau), mod)[lags])
             kinds.append((kind, tau))
+    h_known, known_lrv = np.zeros(1), 0.0
+    if known is not None and ub is not None and known[0] > 0:
+        sigma, tau_k = float(known[0]), max(float(known[1]) / step, 1e-3)
+        h_known = sigma ** 2 * np.exp(-np.arange(_span(tau_k, m) + 1) / tau_k)
+        obs = obs - basis(h_known, ub)[lags]
+        known_lrv = gain * float(h_known[0] + 2.0 * h_known[1:].sum())
     coef = nnls(np.column_stack(cols), obs)
     terms = [(kind, tau, float(c), gain if kind == "velocity" else 1.0)
              for (kind, tau), c in zip(kinds[1:], coef[1:]) if c > 0]
-    lag = max((_span(t, m) for _, t, _, _ in terms), default=0)
+    lag = max([_span(t, m) for _, t, _, _ in terms] + [h_known.size - 1])
     k = np.arange(lag + 1)
     h, h_vel = np.zeros(lag + 1), np.zeros(lag + 1)
+    h_vel[:h_known.size] += h_known if known_lrv else 0.0
     for kind, tau, amp, _ in terms:
         (h_vel if kind == "velocity" else h)[:] += amp * np.exp(-k / tau)
     h[0] += coef[0]
-    return MultiscaleFit(h, h_vel if h_vel.any() else None, step, terms, float(coef[0]))
+    return MultiscaleFit(h, h_vel if h_vel.any() else None, step, terms, float(coef[0]),
+                         known_lrv)
 
 
 def _span(tau, m):
