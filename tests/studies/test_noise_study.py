@@ -7,7 +7,7 @@ import pytest
 from pitotcal.studies.catalog import STUDIES, run_study
 from pitotcal.studies.noise import NOISE_CASES, PARAMETERS
 
-HEADLINE = r"truth inside ±2σ: (\S+: parameters \S+-\S+, rows \S+, rms z \d+\.\d\d(; )?){3}$"
+HEADLINE = r"truth inside ±2σ: (\S+: parameters \S+-\S+, rows \S+, rms z \d+\.\d\d(; )?){4}$"
 
 
 def test_noise_lean(tmp_path):
