@@ -31,22 +31,14 @@ DENSE_LAGS = 16
 LOG_LAGS = 48
 
 
-# Longest correlation time fitted per kind, as a fraction of the longest lag fitted (a quarter
-# of the record). Noise in the pressure itself (along-path gusts: Dryden L/V of 3-13 s, the
-# transducer) decorrelates within seconds; only a velocity error (the GPS receiver's slow
-# drift) is slow. A slow pressure term is mostly projected away by the fit, so the non-negative
-# fit took one up from the wiggles of the sample autocovariance: on 40 JSBSim flights in 1 m/s
-# turbulence a 46 s term appeared in half of them and the k1/k2 bounds came out 1.35x too wide
-# (rms z 0.74 / 0.70; 0.88 / 0.84 with the ensemble autocovariance of the true noise). Pressure
-# terms up to a sixteenth of the record (15 s of 240 s): 0.82 / 0.77 (docs/measured.md).
-TAU_MAX_FRACTION = {"pressure": 0.25, "velocity": 1.0}
-
 # Degrees of freedom of the fitted model's long-run variance (Student-t widening): one per
-# DOF_TAUS long-run-weighted correlation times. Measured on 40 flights per case (own simulator
-# GPS 0.5 m/s + 0.5 m/s turbulence and 1 m/s turbulence, JSBSim 1 m/s): with the limits above,
-# DOF_TAUS = 1 left k1/k2 1.05-1.25x too wide, no widening at all gave the rms z of the true
-# noise's autocovariance; a quarter keeps a small widening for short records.
-DOF_TAUS = 0.25
+# long-run-weighted correlation time in the record. Measured on 60 flights per case (GPS 0.5 m/s
+# + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
+# module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
+# Gauss-Markov case at 85% coverage. Re-measured on 100 flights each of the own simulator and
+# JSBSim in 1 m/s turbulence (issue 11, docs/measured.md): one per 1 gives k1/k2 rms z
+# 1.04 / 1.00 and 0.89 / 0.87; one per 1/4 1.12 / 1.07 and 0.94 / 0.91.
+DOF_TAUS = 1.0
 
 
 def multiscale_acov(residuals, jac, velocity=None, known=None):
@@ -131,7 +123,7 @@ def fit_multiscale(residuals, jac, velocity=None, known=None):
     for kind, mod in (("pressure", None), ("velocity", ub)):
         if kind == "velocity" and ub is None:
             continue
-        for tau in taus[taus <= TAU_MAX_FRACTION[kind] * kmax]:
+        for tau in taus:
             cols.append(basis(np.exp(-np.arange(_span(tau, m) + 1) / tau), mod)[lags])
             kinds.append((kind, tau))
     h_known, known_lrv = np.zeros(1), 0.0
