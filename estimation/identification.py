@@ -59,12 +59,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     ipopt_options : dict, optional
         IPOPT options (without the ``ipopt.`` prefix), e.g. ``{"max_iter": 50}``.
     gps_error_sigma_mps, gps_error_tau_s : float, optional
-        The GPS receiver's time-correlated velocity error as the user states it: a
-        first-order Gauss-Markov process per component, standard deviation (m/s) and
-        correlation time (s); both or neither. It enters the covariance as a known noise term
-        (`estimation.noise_model.fit_multiscale`): a slow GPS error looks like wind, the
-        residuals cannot show it, so bounds without it are too narrow for the wind (calm
-        air, docs/measured.md). None: no such term (only what the residuals show).
+        The GPS receiver's Gauss-Markov velocity error (m/s, s; both or neither): known noise.
 
     Returns
     -------
@@ -102,16 +97,15 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     Example
     -------
     >>> from tests.synthetic import synthetic_flight        # doctest: +SKIP
-    >>> flight, truth = synthetic_flight(seed=1)             # doctest: +SKIP
-    >>> identify(flight).value("k2")                         # doctest: +SKIP
+    >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
     checks.choice("model", model, (*MODELS, "auto"))
     if gps_noise_std_mps is not None:
         gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0)
     ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
-    gps_error = _gps_error(gps_error_sigma_mps, gps_error_tau_s)
     checks.choice("air", air, AIR_DATA_MODES)
+    gps_error = _gps_error(gps_error_sigma_mps, gps_error_tau_s)
     air_data, air_note = _air_data(flight, air)
     _check_flight(flight, air_data)
     flight, gate_note = robust.gate_flight(flight)

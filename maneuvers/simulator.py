@@ -239,6 +239,12 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
     return flight, qc, vel
 
 
+def default_limits(plan):
+    """The guidance's bank and roll-rate limits: `Limits` with the plan's bank_max_deg."""
+    return Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",
+                                                               Limits.bank_max_deg)))
+
+
 def _plunge(refs, wind, states, opts):
     """(states, w_up at the samples): with `vertical_gusts`, the altitude offset of the
     aircraft's plunge in the vertical gust (`turbulence.plunge_response`) added to the states'
@@ -348,11 +354,9 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
         Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
         `oat_k`. The autopilot flies the plan's true airspeed either way.
-    gps_gm_sigma_mps, gps_gm_tau_s : float
-        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s).
-    vertical_gusts : bool
-        Fly Dryden's vertical gust too: the aircraft plunges with it (altitude, density and
-        GPS climb follow) and V_t includes the air-relative climb (False: as before).
+    gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts : float, float, bool
+        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s);
+        fly Dryden's vertical gust too (`_plunge`; False: as before).
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -376,9 +380,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
                        gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, air_sensors,
                        gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts)
     seed = integer("seed", seed, 0)
-    if limits is None:
-        limits = Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",
-                                                                     Limits.bank_max_deg)))
+    limits = default_limits(plan) if limits is None else limits
     rng_turb, rng_qc, rng_gps = (np.random.default_rng(s)
                                  for s in np.random.SeedSequence(seed).spawn(3))
     refs = references(plan, opts.rate_hz)
