@@ -98,7 +98,7 @@ def lag_weights(lag, window="bartlett"):
 
 
 def colored_covariance(jac, residuals, *, window="multiscale", lag=None, information=None,
-                       instruments=None, velocity=None):
+                       instruments=None, velocity=None, known_velocity=None):
     """Covariance corrected for colored residuals (Morelli & Klein 1997; SIDPAC `colores`).
 
     Parameters
@@ -116,9 +116,10 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
         Truncation lag of "bartlett"/"parzen", samples; Andrews' AR(1) plug-in when None.
     information : ndarray, shape (p, p), optional
         M from the exact Hessian of the objective; S^T S when None.
-    velocity : ndarray, shape (N, 2), optional
+    velocity, known_velocity : ndarray (N, 2), (float, float), optional
         The residual's sensitivities to a velocity disturbance (the wind columns of S): with
-        "multiscale", GPS velocity error and gusts enter as u . d, modulated by the heading.
+        "multiscale", GPS velocity error and gusts enter as u . d, modulated by the heading;
+        and (sigma_mps, tau_samples) of a stated Gauss-Markov velocity error.
 
     Returns
     -------
@@ -138,14 +139,14 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     Coverage of each model on the noise cases: docs/measured.md ("Bounds under real noise");
     Bartlett with Andrews' plug-in lag gave 86% on the T-2 flight. Lags count samples as given;
     time gaps are treated as adjacent samples (`OutputErrorProblem` warns when gaps are not
-    rare). With white residuals this reduces to the plain s^2 (S^T S)^-1.
+    rare). White residuals: the plain s^2 (S^T S)^-1.
     """
     n, p = jac.shape
     a, dof, step, h_vel = 0.0, float("inf"), 1, None
     if window == "multiscale":
         from .noise_model import multiscale_acov
-        h, h_vel, step, a, dof = multiscale_acov(residuals, jac, velocity)
-        lag = (h.size - 1) * step
+        fit, a, dof = multiscale_acov(residuals, jac, velocity, known_velocity)
+        h, h_vel, step, lag = fit.h, fit.h_vel, fit.step, (fit.h.size - 1) * fit.step
     elif window == "exponential":
         h, lag, a, dof = _exponential_acov(residuals, jac)
     else:

@@ -8,7 +8,7 @@ import numpy as np
 
 from pitotcal.core import checks
 from pitotcal.core.airdata import AIR_DATA_MODES
-from pitotcal.core.errors import FlightDataError, ObservabilityError
+from pitotcal.core.errors import FlightDataError, ObservabilityError, PitotcalError
 from pitotcal.core.models import MODELS, get_model
 
 from . import consistency, robust
@@ -34,7 +34,7 @@ _TRIM_ROUNDS = 3
 
 
 def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
-             ipopt_options=None):
+             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -58,6 +58,8 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         estimated from the data when None.
     ipopt_options : dict, optional
         IPOPT options (without the ``ipopt.`` prefix), e.g. ``{"max_iter": 50}``.
+    gps_error_sigma_mps, gps_error_tau_s : float, optional
+        The GPS receiver's Gauss-Markov velocity error (m/s, s; both or neither): known noise.
 
     Returns
     -------
@@ -95,8 +97,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     Example
     -------
     >>> from tests.synthetic import synthetic_flight        # doctest: +SKIP
-    >>> flight, truth = synthetic_flight(seed=1)             # doctest: +SKIP
-    >>> identify(flight).value("k2")                         # doctest: +SKIP
+    >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
     checks.choice("model", model, (*MODELS, "auto"))
@@ -104,6 +105,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0)
     ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
     checks.choice("air", air, AIR_DATA_MODES)
+    gps_error = _gps_error(gps_error_sigma_mps, gps_error_tau_s)
     air_data, air_note = _air_data(flight, air)
     _check_flight(flight, air_data)
     flight, gate_note = robust.gate_flight(flight)
@@ -111,17 +113,30 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     _check_track(flight)
     result, trim_note = _fit_trimmed(flight, functools.partial(
         _identify_any, model=model, gps_noise_std_mps=gps_noise_std_mps,
-        ipopt_options=ipopt_options, air_data=air_data), air_data)
+        ipopt_options=ipopt_options, air_data=air_data, gps_error=gps_error), air_data)
     # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
     warn = tuple(dict.fromkeys(tuple(flight.warnings) + gate_note + trim_note
                                + tuple(result.warnings) + air_note))
     return dataclasses.replace(result, warnings=warn)
 
 
-def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data):
+def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data, gps_error):
     if model == "auto":
-        return _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data)
-    return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data)
+        return _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data, gps_error)
+    return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error)
+
+
+def _gps_error(sigma_mps, tau_s):
+    """(sigma_mps, tau_s) of a stated Gauss-Markov GPS velocity error, or None; both or
+    neither given."""
+    if sigma_mps is None and tau_s is None:
+        return None
+    if sigma_mps is None or tau_s is None:
+        missing = "gps_error_tau_s" if tau_s is None else "gps_error_sigma_mps"
+        raise PitotcalError(f"{missing}: state the GPS velocity error's sigma and correlation "
+                            "time together", param=missing)
+    sigma = checks.number("gps_error_sigma_mps", sigma_mps, 0.0, 10.0)
+    return sigma, checks.positive("gps_error_tau_s", tau_s)
 
 
 def _fit_trimmed(flight, fit, air_data):
@@ -157,13 +172,13 @@ def _fit_trimmed(flight, fit, air_data):
         f"without them: {robust.spans_text(flight.time_s, ~keep)}"),) + step_note
 
 
-def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data):
+def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data, gps_error=None):
     """Every structure in MODELS, the one with the lowest BIC kept (see `identify` Notes)."""
     results, candidates = {}, []
     for name in MODELS:
         try:
             results[name] = _identify_one(flight, name, gps_noise_std_mps, ipopt_options,
-                                          air_data)
+                                          air_data, gps_error)
         except ObservabilityError as exc:
             candidates.append({"model": name, "bic": None, "error": str(exc)})
     if not results:
@@ -192,7 +207,7 @@ def _candidate(result, n_eff):
             "params": dict(zip(result.param_names, map(float, result.params)))}
 
 
-def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data):
+def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error=None):
     m = get_model(model)
     if len(m.params) > 1:
         _check_qci_span(flight, m)
@@ -200,7 +215,7 @@ def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data):
     if key not in _PROBLEMS:
         _PROBLEMS[key] = OutputErrorProblem(model, ipopt_options=ipopt_options)
     result = _PROBLEMS[key].solve(flight, gps_noise_std_mps=gps_noise_std_mps,
-                                  air_data=air_data)
+                                  air_data=air_data, gps_error=gps_error)
     if result.success:
         _check_information(result)
     return result

@@ -35,23 +35,29 @@ LOG_LAGS = 48
 # long-run-weighted correlation time in the record. Measured on 60 flights per case (GPS 0.5 m/s
 # + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
 # module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
-# Gauss-Markov case at 85% coverage.
+# Gauss-Markov case at 85% coverage. Re-measured on 100 flights each of the own simulator and
+# JSBSim in 1 m/s turbulence (issue 11, docs/measured.md): one per 1 gives k1/k2 rms z
+# 1.04 / 1.00 and 0.89 / 0.87; one per 1/4 1.12 / 1.07 and 0.94 / 0.91.
 DOF_TAUS = 1.0
 
 
-def multiscale_acov(residuals, jac, velocity=None):
-    """(h, h_vel, step, a, dof) for `covariance.colored_covariance`: the block-mean
-    autocovariances of `fit_multiscale`, a = exp(-1 / tau) of its long-run-weighted
-    correlation time tau (samples), dof = N / (DOF_TAUS tau). White residuals (lag-1
-    correlation within sampling noise of 0) give h = [R(0)] at full rate."""
+def multiscale_acov(residuals, jac, velocity=None, known=None):
+    """(fit, a, dof) for `covariance.colored_covariance`: the `MultiscaleFit` (block-mean
+    autocovariances), a = exp(-1 / tau) of its long-run-weighted correlation time tau
+    (samples), dof = N / (DOF_TAUS tau). White residuals (lag-1 correlation within sampling
+    noise of 0) and no known term give h = [R(0)] at full rate.
+
+    `known`: (sigma_mps, tau_samples) of a stated Gauss-Markov GPS velocity error, each
+    component (`fit_multiscale`)."""
     n, p = jac.shape
     acov = residual_acf(residuals, 1) * n / max(n - p, 1)
-    if acov[1] <= 3.0 * acov[0] / np.sqrt(n):
-        return acov[:1], None, 1, float(acov[1] / acov[0]), float("inf")
-    fit = fit_multiscale(residuals, jac, velocity)
+    if acov[1] <= 3.0 * acov[0] / np.sqrt(n) and (known is None or velocity is None):
+        fit = MultiscaleFit(acov[:1], None, 1, [], float(acov[0]))
+        return fit, float(acov[1] / acov[0]), float("inf")
+    fit = fit_multiscale(residuals, jac, velocity, known)
     tau = fit.tau_samples
     a = float(np.exp(-1.0 / tau)) if tau > 0 else 0.0
-    return fit.h, fit.h_vel, fit.step, a, (n / (DOF_TAUS * tau) if tau > 0 else float("inf"))
+    return fit, a, (n / (DOF_TAUS * tau) if tau > 0 else float("inf"))
 
 
 class MultiscaleFit:
@@ -59,16 +65,18 @@ class MultiscaleFit:
     and `h_vel` of a velocity disturbance d (GPS velocity error, gusts) that reaches the
     residual as u . d, u the wind sensitivities; and their summary numbers."""
 
-    def __init__(self, h, h_vel, step, terms, white):
+    def __init__(self, h, h_vel, step, terms, white, known_lrv=0.0):
         self.h, self.h_vel, self.step = h, h_vel, step
-        self.terms, self.white = terms, white   # [(kind, tau in blocks, amplitude)]
+        self.terms, self.white = terms, white   # [(kind, tau in blocks, amplitude, gain)]
+        self.known_lrv = known_lrv              # long-run variance of the stated term, Pa^2
 
     @property
     def tau_samples(self):
-        """Long-run-variance-weighted correlation time, samples (0 for white noise)."""
+        """Long-run-variance-weighted correlation time of the fitted terms, samples (0 for
+        white noise); a stated term counts in the total but is not uncertain."""
         lrv = np.array([2.0 * a * t * g for _, t, a, g in self.terms])
         taus = np.array([t for _, t, _, _ in self.terms])
-        total = self.white + lrv.sum()
+        total = self.white + lrv.sum() + self.known_lrv
         return float(self.step * (lrv * taus).sum() / total) if total > 0 else 0.0
 
     def describe(self):
@@ -86,11 +94,15 @@ def block_means(x, step):
     return x[: m * step].reshape(m, step, *x.shape[1:]).mean(axis=1)
 
 
-def fit_multiscale(residuals, jac, velocity=None):
+def fit_multiscale(residuals, jac, velocity=None, known=None):
     """The `MultiscaleFit` of `residuals` at the sensitivities `jac` (N, p).
 
     `velocity` (N, 2): the residual's sensitivities to a velocity disturbance (the wind
-    columns of `jac`); None: pressure-domain terms only.
+    columns of `jac`); None: pressure-domain terms only. `known` (sigma_mps, tau_samples): a
+    Gauss-Markov velocity error stated by the user (the GPS receiver's), autocovariance
+    sigma^2 exp(-|k| / tau) per component; what it puts into the residuals is taken out of
+    their autocovariance before the fit, and it enters h_vel as it is. A slow GPS error
+    looks like wind: the residuals barely show it, so only a statement can count it.
     """
     n, p = jac.shape
     step = max(1, int(np.ceil(n / BLOCK_SAMPLES)))
@@ -114,16 +126,24 @@ def fit_multiscale(residuals, jac, velocity=None):
         for tau in taus:
             cols.append(basis(np.exp(-np.arange(_span(tau, m) + 1) / tau), mod)[lags])
             kinds.append((kind, tau))
+    h_known, known_lrv = np.zeros(1), 0.0
+    if known is not None and ub is not None and known[0] > 0:
+        sigma, tau_k = float(known[0]), max(float(known[1]) / step, 1e-3)
+        h_known = sigma ** 2 * np.exp(-np.arange(_span(tau_k, m) + 1) / tau_k)
+        obs = obs - basis(h_known, ub)[lags]
+        known_lrv = gain * float(h_known[0] + 2.0 * h_known[1:].sum())
     coef = nnls(np.column_stack(cols), obs)
     terms = [(kind, tau, float(c), gain if kind == "velocity" else 1.0)
              for (kind, tau), c in zip(kinds[1:], coef[1:]) if c > 0]
-    lag = max((_span(t, m) for _, t, _, _ in terms), default=0)
+    lag = max([_span(t, m) for _, t, _, _ in terms] + [h_known.size - 1])
     k = np.arange(lag + 1)
     h, h_vel = np.zeros(lag + 1), np.zeros(lag + 1)
+    h_vel[:h_known.size] += h_known if known_lrv else 0.0
     for kind, tau, amp, _ in terms:
         (h_vel if kind == "velocity" else h)[:] += amp * np.exp(-k / tau)
     h[0] += coef[0]
-    return MultiscaleFit(h, h_vel if h_vel.any() else None, step, terms, float(coef[0]))
+    return MultiscaleFit(h, h_vel if h_vel.any() else None, step, terms, float(coef[0]),
+                         known_lrv)
 
 
 def _span(tau, m):

@@ -195,7 +195,8 @@ class OutputErrorProblem:
                       self._built[key].build_s)
         return self._built[key]
 
-    def solve(self, flight, *, gps_noise_std_mps=None, start=None, air_data="incompressible"):
+    def solve(self, flight, *, gps_noise_std_mps=None, start=None, air_data="incompressible",
+              gps_error=None):
         """Identify the coefficients and the wind from `flight`.
 
         Parameters
@@ -211,6 +212,9 @@ class OutputErrorProblem:
             How q_c follows from V_t (`estimation.residual`): "compressible" from the
             flight's `ps_pa` + q_ci and `oat_k`, "reference" from its `ps_ref_pa` and
             `oat_k` (`estimation.identify` checks and chooses; both report "compressible").
+        gps_error : (float, float), optional
+            (sigma_mps, tau_s) of a stated Gauss-Markov GPS velocity error: a known term of
+            the colored-residual covariance (`covariance.colored_covariance`).
 
         Returns
         -------
@@ -227,7 +231,7 @@ class OutputErrorProblem:
         timing["solve"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
-        fit = _refine(self.model, built, x_opt, p_val, weight, ch, flight.time_s)
+        fit = _refine(self.model, built, x_opt, p_val, weight, ch, flight.time_s, gps_error)
         timing["covariance"] = time.perf_counter() - t0
         return _result(self.model, flight, ch, fit, stats, timing, air_data)
 
@@ -250,7 +254,7 @@ def _minimise(model, built, ch, theta0):
     return np.asarray(sol["x"]).ravel(), p_val, values["weight"], built.solver.stats()
 
 
-def _refine(model, built, x_opt, p_val, weight, ch, time_s):
+def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None):
     """Instrumental-variable refinement and both covariances at the output-error optimum."""
     warn = []
     scales = theta_scales(model)
@@ -265,11 +269,16 @@ def _refine(model, built, x_opt, p_val, weight, ch, time_s):
         theta, jac = theta_iv, jac_iv
     residuals = residual(model, theta, *ch.args)
     cov_plain = plain_covariance(jac, residuals, information=info)
+    known = None
+    if gps_error is not None:      # tau in samples of this record's median interval
+        known = (gps_error[0], gps_error[1] / max(float(np.median(np.diff(time_s))), 1e-9))
     if instruments is None:
-        colored = colored_covariance(jac, residuals, information=info, velocity=jac[:, -2:])
+        colored = colored_covariance(jac, residuals, information=info, velocity=jac[:, -2:],
+                                     known_velocity=known)
     else:
         colored = colored_covariance(jac, residuals, information=instruments.T @ jac,
-                                     instruments=instruments, velocity=jac[:, -2:])
+                                     instruments=instruments, velocity=jac[:, -2:],
+                                     known_velocity=known)
     warn += [w for w in (colored.warning, _gap_warning(time_s)) if w]
     return _Fit(theta, residuals, cov_plain, colored, tuple(warn))
 

@@ -50,18 +50,16 @@ def simulate_jsbsim(plan, *, seed=0, aircraft=DEFAULT_AIRCRAFT, center_deg=None,
         options add `engine`, `aircraft` and the Milspec settings with the sigma they make.
     """
     from pitotcal.core.checks import integer
-    from pitotcal.core.dynamics import Limits
 
     from .sim_options import check_plan, sim_options
-    from .simulator import references
+    from .simulator import default_limits, references
 
     check_plan(plan)
     options.pop("air_data", None)
     opts = sim_options(plan, **_sim_option_args(options))
     seed = integer("seed", seed, 0)
     settings = plan.settings or {}
-    if limits is None:
-        limits = Limits(bank_max_deg=float(settings.get("bank_max_deg", Limits.bank_max_deg)))
+    limits = default_limits(plan) if limits is None else limits
     if center_deg is None:
         center_deg = (settings.get("center_lat_deg", DEFAULT_CENTER_DEG[0]),
                       settings.get("center_lon_deg", DEFAULT_CENTER_DEG[1]))

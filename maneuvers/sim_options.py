@@ -43,6 +43,13 @@ SIM_LIMITS = {
 }
 
 
+def _flag(name, value):
+    """A yes/no option: a bool (numpy's included), else PitotcalError naming it."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise PitotcalError(f"{name} must be true or false, got {value!r}", param=name)
+    return bool(value)
+
+
 def _limited(name, value, lo=0.0, *, lo_open=False, key=None):
     """`checks.number` with the `SIM_LIMITS` bound (on |value| when `lo` is None), the reason
     added to the message."""
@@ -84,6 +91,8 @@ class SimOptions:
     # Gauss-Markov GPS velocity error (issue 11): steady-state sigma (m/s; 0 none), tau (s)
     gps_gm_sigma_mps: float = 0.0
     gps_gm_tau_s: float = 30.0
+    # Dryden's vertical gust flown (issue 11): plunge, altitude, GPS climb and V_t
+    vertical_gusts: bool = False
 
     def to_dict(self):
         """As written in the truth JSON (sequences as lists; `air_sensors` only when set)."""
@@ -95,6 +104,8 @@ class SimOptions:
             out["air_sensors"]["gps_bias_mps"] = list(self.air_sensors.gps_bias_mps)
         if not self.gps_gm_sigma_mps:       # without it, the truth JSON stays as it was
             del out["gps_gm_sigma_mps"], out["gps_gm_tau_s"]
+        if not self.vertical_gusts:         # likewise
+            del out["vertical_gusts"]
         return out
 
 
@@ -226,7 +237,8 @@ def _true_k(model, k):
 def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, turbulence_mps,
              turbulence_length_m, rate_hz, qc_noise_pa, qc_quantization_pa, qc_bias_pa,
              qc_scale_error, pneumatic_lag_s, gps_rate_hz, gps_noise_mps, gps_latency_s,
-             air_data="incompressible", sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0):
+             air_data="incompressible", sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
+             vertical_gusts=False):
     """`SimOptions` from `simulate`'s arguments (see there): each checked, naming the parameter,
     the wind's defaults filled from the plan's settings, sizes checked against the plan."""
     settings = plan.settings or {}
@@ -261,7 +273,8 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
         air_data=choice("air_data", air_data, AIR_DATA_MODES),
         air_sensors=_checked_air_sensors(sensors),
         gps_gm_sigma_mps=_limited("gps_gm_sigma_mps", gps_gm_sigma_mps),
-        gps_gm_tau_s=positive("gps_gm_tau_s", gps_gm_tau_s))
+        gps_gm_tau_s=positive("gps_gm_tau_s", gps_gm_tau_s),
+        vertical_gusts=_flag("vertical_gusts", vertical_gusts))
     span_s = float(plan.time_s[-1] - plan.time_s[0])
     _check_samples(opts.rate_hz, span_s)
     _check_pressure_error(opts, plan)

@@ -128,6 +128,8 @@ class WindField:
         d(u_g)/dt, felt at once as an airspeed change.
     drift_mps2 : (float, float)
         Linear drift of the process wind (north, east).
+    gust_w_mps : ndarray (n_dyn,)
+        Dryden's vertical gust, positive down (zeros unless `vertical_gusts`).
     """
 
     wind_n_mps: np.ndarray
@@ -136,6 +138,7 @@ class WindField:
     gust_v_mps: np.ndarray
     gust_u_rate_mps2: np.ndarray
     drift_mps2: tuple
+    gust_w_mps: np.ndarray | None = None
 
 
 def references(plan, rate_hz):
@@ -182,27 +185,33 @@ def wind_field(plan, refs, opts, rng):
                                opts.turbulence_length_m)
         gust = dryden_gusts(n_dyn, dt, scales, float(np.mean(refs.tas_mps)), rng)
         ug, vg = gust[:, 0], gust[:, 1]
+        wg = gust[:, 2] if opts.vertical_gusts else np.zeros(n_dyn)
     else:
-        ug = vg = np.zeros(n_dyn)
+        ug = vg = wg = np.zeros(n_dyn)
     return WindField(wind_n_mps=wn0 + drift_n * (t - t_mid),
                      wind_e_mps=we0 + drift_e * (t - t_mid), gust_u_mps=ug, gust_v_mps=vg,
                      gust_u_rate_mps2=np.gradient(ug, dt) if n_dyn > 1 else np.zeros(n_dyn),
-                     drift_mps2=opts.wind_drift_mps2)
+                     drift_mps2=opts.wind_drift_mps2, gust_w_mps=wg)
 
 
-def _record(t, states, opts, seed, rng_qc, rng_gps):
-    """The sensors' records of the states at the sample times: (Flight, qc_pa, true velocity)."""
+def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
+    """The sensors' records of the states at the sample times: (Flight, qc_pa, true velocity).
+    `w_up_mps`: the air mass's vertical velocity; V_t then includes the air-relative climb."""
     _, _, alt, psi, tas, _, wn, we = states.T
     dt, n = 1.0 / opts.rate_hz, t.size
+    v_air = tas                   # horizontal true airspeed, + the air-relative climb if given
+    if w_up_mps is not None:
+        climb_air = (np.gradient(alt, dt) if n > 1 else np.zeros(n)) - w_up_mps
+        v_air = np.sqrt(tas ** 2 + climb_air ** 2)
     rho = isa_density_kgm3(alt)
     static = {}
     if opts.air_data == "compressible":
         # isentropic, at the ISA static pressure and temperature rho is made of
         ps, oat = isa_pressure_pa(alt), isa_temperature_k(alt)
-        qc = qc_from_tas_sq_pa(tas ** 2, ps, oat)
+        qc = qc_from_tas_sq_pa(v_air ** 2, ps, oat)
         static = {"ps_pa": static_port_pa(ps, qc, opts.model, opts.k), "oat_k": oat}
     else:
-        qc = impact_pressure_pa(rho, tas ** 2)
+        qc = impact_pressure_pa(rho, v_air ** 2)
     air = {}
     if opts.air_sensors is not None:      # issue 9 item 7: temperature, humidity, probe arm
         qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
@@ -228,6 +237,30 @@ def _record(t, states, opts, seed, rng_qc, rng_gps):
                     rho_kgm3=rho, gps_vd_mps=gps[:, 2], alt_m=alt,
                     source=f"simulate(seed={seed})", meta=meta, **(air or static))
     return flight, qc, vel
+
+
+def default_limits(plan):
+    """The guidance's bank and roll-rate limits: `Limits` with the plan's bank_max_deg."""
+    return Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",
+                                                               Limits.bank_max_deg)))
+
+
+def _plunge(refs, wind, states, opts):
+    """(states, w_up at the samples): with `vertical_gusts`, the altitude offset of the
+    aircraft's plunge in the vertical gust (`turbulence.plunge_response`) added to the states'
+    altitude; else (states, None)."""
+    if not opts.vertical_gusts or not np.any(wind.gust_w_mps):
+        return states, None
+    from .autopilot import GUIDANCE_GAINS
+    from .turbulence import plunge_response
+
+    sub = refs.steps_per_sample
+    rho = float(np.mean(isa_density_kgm3(states[:, 2])))
+    dh, _ = plunge_response(wind.gust_w_mps, refs.dt_s, float(np.mean(refs.tas_mps)), rho,
+                            GUIDANCE_GAINS["k_alt_per_s"])
+    out = states.copy()
+    out[:, 2] += dh[::sub]
+    return out, -wind.gust_w_mps[::sub]
 
 
 def _tracking(plan, refs, states, path_index, rho):
@@ -282,7 +315,8 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
              rate_hz=50.0, qc_noise_pa=0.5, qc_quantization_pa=0.0, qc_bias_pa=0.0,
              qc_scale_error=0.0, pneumatic_lag_s=0.0, gps_rate_hz=5.0, gps_noise_mps=0.05,
              gps_latency_s=0.0, air_data="incompressible", limits=None, speed_loop=None,
-             keep_history=False, air_sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0):
+             keep_history=False, air_sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
+             vertical_gusts=False):
     """Fly `plan` in simulation and record what the sensors would log.
 
     Parameters
@@ -320,8 +354,9 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
         Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
         `oat_k`. The autopilot flies the plan's true airspeed either way.
-    gps_gm_sigma_mps, gps_gm_tau_s : float
-        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s).
+    gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts : float, float, bool
+        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s);
+        fly Dryden's vertical gust too (`_plunge`; False: as before).
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
@@ -343,11 +378,9 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
                        turbulence_mps, turbulence_length_m, rate_hz, qc_noise_pa,
                        qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s,
                        gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, air_sensors,
-                       gps_gm_sigma_mps, gps_gm_tau_s)
+                       gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts)
     seed = integer("seed", seed, 0)
-    if limits is None:
-        limits = Limits(bank_max_deg=float((plan.settings or {}).get("bank_max_deg",
-                                                                     Limits.bank_max_deg)))
+    limits = default_limits(plan) if limits is None else limits
     rng_turb, rng_qc, rng_gps = (np.random.default_rng(s)
                                  for s in np.random.SeedSequence(seed).spawn(3))
     refs = references(plan, opts.rate_hz)
@@ -355,7 +388,8 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     if speed_loop is None:
         speed_loop = tune_autothrottle(0.5 * float(plan.tas_mps.min() + plan.tas_mps.max()))
     states, path_index = fly(refs, wind, speed_loop, limits)
-    flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps)
+    states, w_up = _plunge(refs, wind, states, opts)
+    flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps, w_up)
     tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)
     history = _history(plan, refs, wind, states, flight, qc, vel) if keep_history else None
     loop = {"kp": speed_loop.kp, "ki": speed_loop.ki, "engine_lag_s": speed_loop.engine_lag_s,

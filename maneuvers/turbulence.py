@@ -33,7 +33,8 @@ import numpy as np
 from pitotcal.core.checks import integer, number, positive
 from pitotcal.core.units import FT_TO_M
 
-__all__ = ["DrydenScales", "along_path_gust", "dryden_filters", "dryden_gusts", "dryden_scales"]
+__all__ = ["DrydenScales", "along_path_gust", "dryden_filters", "dryden_gusts", "dryden_scales",
+           "plunge_response"]
 
 _LOW_FT, _HIGH_FT = 1000.0, 2000.0
 _HIGH_SCALE_FT = 1750.0
@@ -195,3 +196,42 @@ def along_path_gust(n, dt_s, scales, tas_mps, rng):
         y = c * x + a * y
         out.append(y)
     return np.array(out[burn:])
+
+
+# Plunge (heave) of the aircraft in a vertical gust: a gust changes the angle of attack, the
+# lift change accelerates the aircraft with the air mass, dv_z/dt = (w_air - v_z) / tau_p,
+# tau_p = 2 (W/S) / (g rho V C_L_alpha) (Etkin & Reid, "Dynamics of Flight", the plunge mode).
+# A light aircraft's wing loading and lift slope; tau_p ~ 0.5 s at 40 m/s near sea level.
+WING_LOADING_NPM2 = 600.0
+LIFT_SLOPE_PER_RAD = 5.0
+
+
+def plunge_response(w_down_mps, dt_s, tas_mps, rho_kgm3, k_alt_per_s):
+    """The aircraft's response to the vertical gust: altitude offset and climb-rate offset.
+
+    Parameters
+    ----------
+    w_down_mps : ndarray (n,)
+        Vertical gust, positive down (`dryden_gusts` column w), on a grid of step `dt_s`.
+    tas_mps, rho_kgm3 : float
+        Mean true airspeed and density of the flight.
+    k_alt_per_s : float
+        Gain of the autopilot's altitude hold (climb command per metre of error), which
+        pulls the offset back.
+
+    Returns
+    -------
+    dh_m, vz_mps : ndarray (n,)
+        Altitude offset and the aircraft's extra climb rate (up), by forward Euler of
+        dv_z/dt = (-w - v_z) / tau_p and dh/dt = v_z - k_alt dh (linear, so it adds to the
+        flight the autopilot flies). The air-relative vertical velocity is then
+        v_z + climb - (-w): the fast part of the gust, what reaches the angle of attack.
+    """
+    tau = 2.0 * WING_LOADING_NPM2 / (9.80665 * rho_kgm3 * tas_mps * LIFT_SLOPE_PER_RAD)
+    a = min(dt_s / tau, 1.0)
+    vz, dh = np.zeros(w_down_mps.size), np.zeros(w_down_mps.size)
+    v = h = 0.0
+    for i, w in enumerate((-np.asarray(w_down_mps, dtype=float)).tolist()):
+        vz[i], dh[i] = v, h
+        v, h = v + a * (w - v), h + dt_s * (v - k_alt_per_s * h)
+    return dh, vz

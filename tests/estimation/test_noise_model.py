@@ -55,3 +55,28 @@ def test_white_noise_reduces_to_plain_and_nnls_is_exact():
     np.testing.assert_allclose(nnls(a, a @ x), x, atol=1e-9)
     assert np.all(nnls(a, -a @ x) >= 0)
     np.testing.assert_allclose(block_means(np.arange(7.0), 3), [1.0, 4.0])
+
+
+def test_stated_slow_velocity_error_is_counted():
+    """A velocity error slower than the record can show (tau = its length) looks like
+    the wind: unstated, the wind's sigma comes out well short of the scatter; stated as
+    known_velocity (sigma, tau), it matches."""
+    rng = np.random.default_rng(5)
+    n, runs, sigma, tau = 1200, 50, 0.5, 1200.0
+    t = np.arange(n)
+    heading = 2 * np.pi * t / 300.0
+    u = np.column_stack([np.cos(heading), np.sin(heading)])
+    jac = np.column_stack([1.0 + t / n, u])
+    est, sig, sig_unstated = [], [], []
+    for _ in range(runs):
+        noise = 0.3 * rng.standard_normal(n) + sigma * np.sum(u * _ou(rng, n, tau, (2,)), axis=1)
+        beta = np.linalg.lstsq(jac, noise, rcond=None)[0]
+        r = noise - jac @ beta
+        est.append(beta)
+        got = colored_covariance(jac, r, velocity=u, known_velocity=(sigma, tau))
+        sig.append(np.sqrt(np.diag(got.covariance)))
+        sig_unstated.append(np.sqrt(np.diag(colored_covariance(jac, r, velocity=u).covariance)))
+    scatter = np.std(est, axis=0)
+    ratio = np.median(sig, axis=0)[1:] / scatter[1:]
+    assert np.all(ratio > 0.8) and np.all(ratio < 1.25), ratio
+    assert np.all(np.median(sig_unstated, axis=0)[1:] / scatter[1:] < 0.7), ratio

@@ -64,6 +64,15 @@ def add_parser(subparsers):
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
     _add_budget_arguments(p)
+    # --- issue 11: the GPS receiver's time-correlated velocity error, stated ---
+    gps = p.add_argument_group("GPS velocity error (a known term of the bounds)")
+    gps.add_argument("--gps-error-sigma-mps", type=float, default=None, metavar="SIGMA",
+                     help="the GPS receiver's slowly varying velocity error per component, "
+                          "m/s (first-order Gauss-Markov; e.g. 0.05 from its data sheet); "
+                          "counted in the bounds, because the residuals cannot show it (it "
+                          "looks like wind); with --gps-error-tau-s; default: none stated")
+    gps.add_argument("--gps-error-tau-s", type=float, default=None, metavar="S",
+                     help="its correlation time, s (e.g. 30); with --gps-error-sigma-mps")
     p.set_defaults(run=run)
 
 
@@ -142,13 +151,13 @@ def run(args):
     inputs = None if args.no_budget else _budget_inputs(args)
     flight, autopilot, current = _read(args, source)
     result = identify(flight, model=args.model, air=args.air,
-                      gps_noise_std_mps=args.gps_noise_mps)
+                      gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))
     budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
 
     # issue 15: every file is written before anything is printed, so a reader that goes
     # away early (`| head`) never costs a file
     if args.json is not None:
-        _write_json(args.json, result, flight, source, budget)
+        _write_json(args.json, result, flight, source, budget, _gps_error(args))
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
     params, refused = None, None
@@ -263,7 +272,13 @@ def _print_params(rec, path):
         print(f"  note: {note}")
 
 
-def _write_json(path, result, flight, source, budget=None):
+def _gps_error(args):
+    """identify's stated GPS error keywords; JSON "gps_error" (docs/interfaces.md §19)."""
+    return {"gps_error_sigma_mps": args.gps_error_sigma_mps,
+            "gps_error_tau_s": args.gps_error_tau_s}
+
+
+def _write_json(path, result, flight, source, budget=None, gps_error=None):
     """The result JSON, with every warning the reader gave in its "warnings"."""
     from pitotcal.estimation.budget_report import add_budget
     from pitotcal.io.jsonfile import json_ready, write_json
@@ -275,6 +290,10 @@ def _write_json(path, result, flight, source, budget=None):
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
     out.update(_monitor_noise_model(result))
+    if gps_error is not None:       # issue 11: the stated GPS error the bounds count
+        stated = gps_error["gps_error_sigma_mps"] is not None
+        out["gps_error"] = {"stated": stated, "sigma_mps": gps_error["gps_error_sigma_mps"],
+                            "tau_s": gps_error["gps_error_tau_s"]}
     write_json(path, out)
 
 

@@ -42,6 +42,11 @@ def add_parser(subparsers):
                    help="time-correlated (Gauss-Markov) GPS velocity error std, m/s (0: none)")
     s.add_argument("--gps-gm-tau-s", type=float, default=30.0,
                    help="its correlation time, s (30)")
+    # issue 11: Dryden's vertical gust flown (plunge, altitude, GPS climb, V_t)
+    s.add_argument("--vertical-gusts", action="store_true",
+                   help="fly the vertical gust too: the aircraft plunges with it and the "
+                        "airspeed includes the air-relative climb (own engine; JSBSim's "
+                        "turbulence always has it)")
     g.add_argument("--air-data", default=None,
                    help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
                         "the paper's eq. 2; default) or compressible (isentropic, ISA p and T); "
@@ -185,7 +190,8 @@ def run(args):
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
         gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
         keep_history=fault is not None, gps_gm_sigma_mps=args.gps_gm_sigma_mps,
-        gps_gm_tau_s=args.gps_gm_tau_s, **_air_sensor_option(args))
+        gps_gm_tau_s=args.gps_gm_tau_s, **_air_sensor_option(args),
+        **({"vertical_gusts": True} if args.vertical_gusts else {}))
     if fault is not None:
         from pitotcal.maneuvers.faults import apply_fault
         flight = apply_fault(flight, truth, fault)
