@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pitotcal.core.information import student_t_widening
+
 from .noise_model import _fast_len, _inv_sym, block_means, residual_acf
 
 __all__ = [
@@ -182,17 +184,6 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
                    "independent stretches of data, so the corrected bounds are themselves "
                    f"uncertain by ~{100 / np.sqrt(max(stretches, 1.0)):.0f}%; fly longer")
     return ColoredCovariance(cov, lag, window, a, warning, dof)
-
-
-def student_t_widening(dof, z=2.0):
-    """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
-    dof >= 3, without importing scipy.stats); 1 for infinite dof."""
-    if not np.isfinite(dof):
-        return 1.0
-    v = max(float(dof), 3.0)
-    t = (z + (z ** 3 + z) / (4 * v) + (5 * z ** 5 + 16 * z ** 3 + 3 * z) / (96 * v ** 2)
-         + (3 * z ** 7 + 19 * z ** 5 + 17 * z ** 3 - 15 * z) / (384 * v ** 3))
-    return t / z
 
 
 def _exponential_acov(residuals, jac):

@@ -18,6 +18,8 @@ contribution to the long-run variance, the short ones included, at a cost indepe
 
 import numpy as np
 
+from pitotcal.core.information import DOF_TAUS
+
 __all__ = ["MultiscaleFit", "block_means", "fit_multiscale", "multiscale_acov", "nnls",
            "residual_acf"]
 
@@ -31,14 +33,6 @@ DENSE_LAGS = 16
 LOG_LAGS = 48
 
 
-# Degrees of freedom of the fitted model's long-run variance (Student-t widening): one per
-# long-run-weighted correlation time in the record. Measured on 60 flights per case (GPS 0.5 m/s
-# + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
-# module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
-# Gauss-Markov case at 85% coverage. Re-measured on 100 flights each of the own simulator and
-# JSBSim in 1 m/s turbulence (issue 11, docs/measured.md): one per 1 gives k1/k2 rms z
-# 1.04 / 1.00 and 0.89 / 0.87; one per 1/4 1.12 / 1.07 and 0.94 / 0.91.
-DOF_TAUS = 1.0
 
 
 def multiscale_acov(residuals, jac, velocity=None, known=None):
