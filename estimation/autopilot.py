@@ -96,8 +96,8 @@ class ParameterRecommendation:
         return lines + list(self.notes)
 
 
-def recommend(flight, autopilot, current=None, *, gps_noise_std_mps=None, name=None,
-              air="compressible"):
+def recommend(flight, autopilot, current=None, *, name=None, air="compressible",
+              **noise):
     """The airspeed parameter for `autopilot` from `flight`, or a refusal.
 
     Parameters
@@ -106,12 +106,13 @@ def recommend(flight, autopilot, current=None, *, gps_noise_std_mps=None, name=N
     autopilot : {"ArduPilot", "PX4"}
     current : float, optional
         The value the log was flown with.
-    gps_noise_std_mps : float, optional
-        Passed to `identify`.
     name : str, optional
         Parameter name (default ``ARSPD_RATIO`` / ``ASPD_SCALE_1``).
     air : {"compressible", "incompressible"}
         Passed to `identify` (a flight without static pressure is fitted incompressible).
+    **noise
+        `identify`'s noise keywords, passed on: ``gps_noise_std_mps``, ``gps_error_sigma_mps``,
+        ``gps_error_tau_s``.
 
     Returns
     -------
@@ -134,11 +135,11 @@ def recommend(flight, autopilot, current=None, *, gps_noise_std_mps=None, name=N
         raise PitotcalError(f"no parameter recommended: the track turned through only "
                             f"{spread:.0f} deg (need {MIN_TRACK_SPREAD_DEG:.0f} before "
                             f"committing {name}); fly a full circle")
-    const = identify(flight, model="constant", gps_noise_std_mps=gps_noise_std_mps, air=air)
+    const = identify(flight, model="constant", air=air, **noise)
     if not const.success:
         raise PitotcalError(f"no parameter recommended: the constant-model fit did not "
                             f"converge ({const.message})")
-    departures, notes = _departures(flight, const, gps_noise_std_mps, air)
+    departures, notes = _departures(flight, const, noise, air)
     for model, d in departures.items():
         if d["max_departure_kt"] > d["two_sigma_kt"]:
             raise PitotcalError(
@@ -187,14 +188,14 @@ def _check_bounds(name, value, two_sigma, current, autopilot):
             f"of airspeed, need <= {100 * TOLERANCE:g} %) and {where}; fly longer or steadier")
 
 
-def _departures(flight, const, gps_noise_std_mps, air):
+def _departures(flight, const, noise, air):
     """How far the two-coefficient models depart from the constant one over the flown range."""
     from .identification import identify
 
     out, notes = {}, []
     for model in ("inverse", "linear"):
         try:
-            res = identify(flight, model=model, gps_noise_std_mps=gps_noise_std_mps, air=air)
+            res = identify(flight, model=model, air=air, **noise)
         except ObservabilityError as exc:
             notes.append(f"{model} model not identifiable ({exc}); one scale not tested "
                          "against it")

@@ -34,6 +34,17 @@ def test_ardupilot_ratio_recovers_the_truth_and_loads_in_pymavlink(constant_flig
     assert "2 sigma" in text and "current value 1.6" in text and "new / current" in text
 
 
+def test_a_stated_gps_error_reaches_the_recommendation(constant_flight):
+    """identify --params passes the receiver's stated slow velocity error on: a slow GPS bias
+    the residuals cannot show widens the ratio's bound (issue 11)."""
+    plain = recommend(constant_flight, "ArduPilot", current=1.6)
+    stated = recommend(constant_flight, "ArduPilot", current=1.6, gps_error_sigma_mps=0.3,
+                       gps_error_tau_s=60.0)
+    truth = 2.0 / (RHO0_KGM3 * (1.0 - K1))
+    assert stated.two_sigma > 1.2 * plain.two_sigma
+    assert abs(stated.value - truth) <= stated.two_sigma
+
+
 def test_px4_scale_is_the_square_root_and_parses_as_qgc(constant_flight, tmp_path):
     rec = recommend(constant_flight, "PX4", current=1.0)
     assert abs(rec.value - 1.0 / math.sqrt(1.0 - K1)) <= rec.two_sigma

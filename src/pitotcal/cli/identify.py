@@ -259,7 +259,8 @@ def _write_params(args, flight, autopilot, current):
     name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
         if autopilot == "PX4" else None
     rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
-                    gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air)
+                    gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air,
+                    **_gps_error(args))
     write_parameter_file(rec, args.params)
     return rec
 
