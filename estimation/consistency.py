@@ -42,7 +42,7 @@ HIDDEN_RATIO = 3.0
 # ... and by more than this, kt: below what an airspeed indicator shows.
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
-_WINDOW = "multiscale"
+_WINDOW = "exponential"
 
 
 def step_test(flight, result, air_data):
@@ -77,10 +77,10 @@ def step_test(flight, result, air_data):
     r = result.residuals_pa
     t = flight.time_s
     onsets, steps = _step_columns(t, ch.qci)
-    scan = _scan(jac, r, steps)
     threshold = float(norm.isf(ALPHA / (2.0 * ONSETS.size)))
+    scan = _scan(jac, r, steps, threshold)
     z = scan["beta"] / scan["sigma"]
-    best = int(np.argmax(np.abs(z)))
+    best = scan["best"]
     details = {"onset_s": float(onsets[best]), "step": float(-scan["beta"][best]),
                "z": float(z[best]), "threshold": threshold, "alpha": ALPHA,
                "flagged": bool(abs(z[best]) > threshold)}
@@ -123,57 +123,56 @@ def _step_columns(t, qci):
     return onsets, steps
 
 
-def _scan(jac, r, steps):
+def _scan(jac, r, steps, threshold):
     """The augmented fit [S, g_k] of every onset k: step coefficients, their sigmas, and the
     parameter shift per unit step of the plain fit that absorbs g_k (and of a change of scale
-    over the whole record, the last row).
+    over the whole record, `shift_all`).
 
-    One noise-model fit serves every onset: it is fitted to the residuals of the augmented
-    fit at the onset of the largest white-noise |z| (on the plain fit's residuals a real step
-    would count as noise and hide itself), and `colored_covariance` with the columns [S, G]
-    as instruments and the identity as information returns the sandwich's middle
-    [S, G]^T R_vv [S, G] (with its Student-t widening); each onset's covariance is
-    M_k^-1 middle_k M_k^-1 on its (p + 1) columns. The white-noise variance is a floor.
+    The white-noise sigmas come first: a step is a low-frequency regressor, so under the
+    positively correlated residuals of flight its colored sigma is larger, and where no
+    white-noise |z| exceeds the threshold no colored one does. The noise-model fit, the
+    test's main cost, is spent only on the onset of the largest white-noise |z| when it is
+    over the threshold: fitted to the residuals of the augmented fit there (on the plain
+    fit's residuals a real step would count as noise and hide itself), the white-noise
+    variance a floor.
     """
     n, p = jac.shape
     m = steps.shape[1]
     x = np.column_stack([jac, steps])
-    gram, xr = x.T @ x, x.T @ r
+    gram, xr, rr = x.T @ x, x.T @ r, float(r @ r)
+    cols = [np.r_[np.arange(p), p + k] for k in range(m)]
+    inv_k = [np.linalg.inv(gram[np.ix_(idx, idx)]) for idx in cols]
+    coef = [mk @ xr[idx] for mk, idx in zip(inv_k, cols)]
+    beta = np.array([c[-1] for c in coef])
+    # residual sum of squares of each augmented fit by the normal equations
+    s2 = np.array([max(rr - c @ xr[idx], 0.0) for c, idx in zip(coef, cols)]) / max(n - p - 1, 1)
+    sigma = np.sqrt(s2 * np.array([mk[-1, -1] for mk in inv_k]))
+    plain = sigma.copy()
+    best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
+    if abs(beta[best]) > threshold * sigma[best]:
+        idx = cols[best]
+        fitted = r - x[:, idx] @ coef[best]
+        cov = colored_covariance(x[:, idx], fitted, window=_WINDOW, information=gram[np.ix_(
+            idx, idx)], velocity=jac[:, -2:]).covariance
+        sigma[best] = np.sqrt(max(cov[-1, -1], sigma[best] ** 2))
     m_inv = np.linalg.inv(gram[:p, :p])
-    inv_k = [np.linalg.inv(gram[np.ix_(idx, idx)]) for idx in _columns(p, m)]
-    beta = np.array([(mk @ xr[idx])[-1] for mk, idx in zip(inv_k, _columns(p, m))])
-    s2 = np.array([_rss(r, x[:, idx], mk @ xr[idx]) / max(n - p - 1, 1)
-                   for mk, idx in zip(inv_k, _columns(p, m))])
-    plain = np.sqrt(s2 * np.array([mk[-1, -1] for mk in inv_k]))
-    best = int(np.argmax(np.abs(beta[1:]) / plain[1:])) + 1
-    idx = _columns(p, m)[best]
-    fitted = r - x[:, idx] @ (inv_k[best] @ xr[idx])
-    middle = colored_covariance(x[:, idx], fitted, window=_WINDOW, instruments=x,
-                                information=np.eye(x.shape[1]),
-                                velocity=jac[:, -2:]).covariance
-    sigma = np.array([np.sqrt(max((mk @ middle[np.ix_(idx, idx)] @ mk)[-1, -1], pl ** 2))
-                      for mk, idx, pl in zip(inv_k, _columns(p, m), plain)])
     # how far the plain fit moves per unit of q_ci low (s = -beta): r is q_ci - predicted
     shift = (m_inv @ gram[:p, p:]).T
-    cov = m_inv @ middle[:p, :p] @ m_inv      # the parameters' covariance under this noise model
-    return {"beta": beta[1:], "sigma": sigma[1:], "shift": shift[1:], "shift_all": shift[0],
-            "cov": np.maximum(cov, 0.0) if p == 1 else 0.5 * (cov + cov.T)}
-
-
-def _columns(p, m):
-    return [np.r_[np.arange(p), p + k] for k in range(m)]
-
-
-def _rss(r, x, coef):
-    e = r - x @ coef
-    return float(e @ e)
+    return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:],
+            "shift": shift[1:],
+            "shift_all": shift[0], "cov_plain": float(np.mean(s2[1:])) * m_inv}
 
 
 def _undetected(result, model, onsets, scan, z_detect):
     """The onset where the smallest detected step, z_detect sigma, moves ΔV most against
-    its 2-sigma band, and the numbers. The band is that of the flown V_i grid under the test's
-    noise model (fitted with the step; a real step would widen the reported band by counting
-    itself as noise), so the ratio measures the maneuver, not the flight's luck.
+    its 2-sigma band, and the numbers.
+
+    Step and coefficients are set side by side in white noise, where the ratio of the shift
+    to the band is the maneuver's geometry (a real step would widen a colored band by
+    counting itself as noise, and the flight's luck would decide), and both are scaled to
+    the flight's noise by the variance inflation of the identification's own colored
+    covariance over its plain one (median over the coefficients): a step is a slow
+    regressor like them.
 
     The fit that absorbs a step s at t0 sits between the calibration before (it is off it by
     the shift d_k s) and the one after (a change of scale over the whole record, d_all s): the
@@ -185,14 +184,19 @@ def _undetected(result, model, onsets, scan, z_detect):
 
     nk = len(model.params)
     k = np.asarray(result.internal_params[:nk], dtype=float)
-    cov_k = scan["cov"][:nk, :nk]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.diag(result.internal_covariance)[:nk] \
+            / np.diag(result.internal_covariance_plain)[:nk]
+    ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
+    inflation = float(np.median(ratio)) if ratio.size else 1.0
+    cov_k = inflation * scan["cov_plain"][:nk, :nk]
     vi = np.array([row["vi_kt"] for row in result.correction_table()], dtype=float)
     dv_fit = delta_v_kt(model, k, vi, result.air_data)
     grad = gradient(lambda kk: delta_v_kt(model, kk, vi, result.air_data), k)
     band = np.maximum(2.0 * sigma_of(grad, cov_k), 1e-12)
     best = None
     for i, onset in enumerate(onsets):
-        size = z_detect * scan["sigma"][i]
+        size = z_detect * scan["plain"][i] * np.sqrt(inflation)
         off = [scan["shift"][i, :nk] * size,                                   # from before
                (scan["shift"][i, :nk] - scan["shift_all"][:nk]) * size]        # from after
         dv = [np.abs(dv_fit - delta_v_kt(model, k - dk, vi, result.air_data)) for dk in off]
