@@ -25,8 +25,8 @@ from pitotcal.core.models import delta_v_kt, get_model
 from .covariance import colored_covariance
 from .residual import flight_channels, sensitivities
 
-__all__ = ["ALPHA", "HIDDEN_RATIO", "MIN_SHIFT_KT", "ONSETS", "POWER", "hidden_warning",
-           "step_test"]
+__all__ = ["ALPHA", "HIDDEN_RATIO", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
+           "hidden_warning", "step_test"]
 
 # Onsets scanned, as fractions of the record: at least a fifth of it on each side.
 ONSETS = np.linspace(0.2, 0.8, 13)
@@ -43,6 +43,22 @@ HIDDEN_RATIO = 3.0
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
 _WINDOW = "exponential"
+
+
+def check(flight, result, air_data):
+    """(warnings, details): every consistency test on a converged fit.
+
+    The change of scale (`step_test`), the abrupt jump (`estimation.jumps.jump_test`, its
+    details under ``jump``) and, when neither flags the flight, whether the maneuver hides a
+    change of scale from the calibration (`hidden_warning`). `details` is the result's
+    `consistency` (JSON ``consistency``, docs/interfaces.md §19).
+    """
+    from .jumps import jump_test
+
+    step_note, details = step_test(flight, result, air_data)
+    jump_note, details["jump"] = jump_test(flight)
+    hidden = None if jump_note else hidden_warning(flight.source, details)
+    return tuple(w for w in (step_note, jump_note, hidden) if w), details
 
 
 def step_test(flight, result, air_data):

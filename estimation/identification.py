@@ -146,10 +146,8 @@ def _fit_trimmed(flight, fit, air_data):
                 "look for a leak, a blockage or a bad channel")
         result = fit(flight.select(keep))
     kept = flight.select(keep) if not keep.all() else flight
-    step_note, check = consistency.step_test(kept, result, air_data) if result.success \
-        else (None, {})
-    step_note = tuple(w for w in (step_note, check and consistency.hidden_warning(
-        flight.source, check)) if w)
+    step_note, check = consistency.check(kept, result, air_data) if result.success \
+        else ((), {})
     result = dataclasses.replace(result, consistency=check)
     if keep.all():
         return result, step_note

@@ -114,3 +114,53 @@ def test_calm_sweep_hides_nothing_an_indicator_shows():
     assert not details["flagged"] and not details["hidden"]
     assert details["undetected"]["dv_shift_kt"] < consistency.MIN_SHIFT_KT
     assert details["undetected"]["step"] < 0.01
+
+
+# --- abrupt jumps (estimation.jumps) ------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def turbulent():
+    """A one-way sweep in 1 m/s turbulence with 5 Hz GPS, its fit, and the leak's onset."""
+    flight, _ = synthetic_flight(seed=8, n=12000, turbulence_mps=1.0, gps_rate_hz=5.0,
+                                 gps_noise_mps=0.1)
+    return flight, flight.time_s[flight.n // 2 + 7]
+
+
+def test_abrupt_leak_in_turbulence_is_named_at_its_sample(turbulent):
+    """3 % from mid-flight in 1 m/s turbulence: the change of scale hides in the slow noise,
+    the jump does not: a warning naming the sample and the size."""
+    flight, onset = turbulent
+    result = _fit(_leak(flight, 0.03, onset))
+    jump = result.consistency["jump"]
+    assert jump["flagged"] and jump["time_s"] == pytest.approx(onset)
+    assert jump["step"] == pytest.approx(0.03, abs=0.01)
+    note = [w for w in result.warnings if "jumps at" in w]
+    assert len(note) == 1 and f"t = {onset:.2f} s" in note[0]
+    assert not [w for w in result.warnings if HIDES in w]
+
+
+def test_clean_turbulent_flight_has_no_jump(turbulent):
+    flight, _ = turbulent
+    jump = _fit(flight).consistency["jump"]
+    assert not jump["flagged"] and abs(jump["z"]) < jump["threshold"]
+
+
+def test_a_spike_is_not_a_jump(turbulent):
+    """Two samples 5 % low and back: neither median moves, so no lasting jump."""
+    from pitotcal.estimation.jumps import jump_test
+
+    flight, onset = turbulent
+    i = int(np.searchsorted(flight.time_s, onset))
+    qci = flight.qci_pa.copy()
+    qci[i:i + 2] *= 0.95
+    warning, details = jump_test(dataclasses.replace(flight, qci_pa=qci))
+    assert warning is None and not details["flagged"]
+    assert jump_test(_leak(flight, 0.05, onset))[1]["flagged"]      # the same, lasting
+
+
+def test_held_qci_is_not_tested():
+    from pitotcal.estimation.jumps import jump_test
+
+    flight, _ = synthetic_flight(seed=9, n=2000, quantization_pa=5.0)
+    warning, details = jump_test(flight)
+    assert warning is None and "held or quantized" in details["skipped"]
