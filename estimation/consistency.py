@@ -23,6 +23,7 @@ import numpy as np
 from pitotcal.core.models import delta_v_kt, get_model
 
 from .covariance import colored_covariance
+from .noise_model import block_means
 from .residual import flight_channels, sensitivities
 
 __all__ = ["ALPHA", "HIDDEN_RATIO", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
@@ -43,6 +44,8 @@ HIDDEN_RATIO = 3.0
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
 _WINDOW = "exponential"
+# Blocks the colored variance is computed on (at most).
+_BLOCKS = 4000
 
 
 def check(flight, result, air_data):
@@ -167,9 +170,13 @@ def _scan(jac, r, steps, threshold):
     best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
     if abs(beta[best]) > threshold * sigma[best]:
         idx = cols[best]
-        fitted = r - x[:, idx] @ coef[best]
-        cov = colored_covariance(x[:, idx], fitted, window=_WINDOW, information=gram[np.ix_(
-            idx, idx)], velocity=jac[:, -2:]).covariance
+        # on block means of `b` samples: the regressors are smooth over a block (the step is
+        # one jump in ~N / b blocks) and the noise model is fitted to what the blocks keep, at
+        # a cost independent of N
+        b = max(1, int(np.ceil(n / _BLOCKS)))
+        xb = block_means(x[:, idx], b)
+        eb = block_means(r - x[:, idx] @ coef[best], b)
+        cov = colored_covariance(xb, eb, window=_WINDOW, velocity=xb[:, p - 2:p]).covariance
         sigma[best] = np.sqrt(max(cov[-1, -1], sigma[best] ** 2))
     m_inv = np.linalg.inv(gram[:p, :p])
     # how far the plain fit moves per unit of q_ci low (s = -beta): r is q_ci - predicted
