@@ -45,7 +45,7 @@ MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
 _WINDOW = "exponential"
 # Blocks the colored variance is computed on (at most).
-_BLOCKS = 4000
+_BLOCKS = 1000
 
 
 def check(flight, result, air_data):
@@ -95,9 +95,10 @@ def step_test(flight, result, air_data):
     jac = sensitivities(model, result.internal_params, *ch.args)
     r = result.residuals_pa
     t = flight.time_s
-    onsets, steps = _step_columns(t, ch.qci)
+    onsets = t[0] + ONSETS * (t[-1] - t[0])
+    first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
     threshold = float(norm.isf(ALPHA / (2.0 * ONSETS.size)))
-    scan = _scan(jac, r, steps, threshold)
+    scan = _scan(jac, r, ch.qci, first, threshold)
     z = scan["beta"] / scan["sigma"]
     best = scan["best"]
     details = {"onset_s": float(onsets[best]), "step": float(-scan["beta"][best]),
@@ -133,32 +134,31 @@ def hidden_warning(source, details):
             "two apart")
 
 
-def _step_columns(t, qci):
-    """(onset times, (N, 1 + len(ONSETS)) regressors q_ci 1[t >= t0], the first over the
-    whole record)."""
-    onsets = t[0] + ONSETS * (t[-1] - t[0])
-    first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
-    steps = np.where(np.arange(t.size)[:, None] >= first[None, :], qci[:, None], 0.0)
-    return onsets, steps
+def _scan(jac, r, qci, first, threshold):
+    """The augmented fit [S, g_k] of every onset k (g_k = q_ci 1[i >= first_k], the first
+    over the whole record): step coefficients, their sigmas, and the parameter shift per unit
+    step of the plain fit that absorbs g_k (and of a change of scale over the whole record,
+    `shift_all`).
 
-
-def _scan(jac, r, steps, threshold):
-    """The augmented fit [S, g_k] of every onset k: step coefficients, their sigmas, and the
-    parameter shift per unit step of the plain fit that absorbs g_k (and of a change of scale
-    over the whole record, `shift_all`).
-
-    The white-noise sigmas come first: a step is a low-frequency regressor, so under the
-    positively correlated residuals of flight its colored sigma is larger, and where no
-    white-noise |z| exceeds the threshold no colored one does. The noise-model fit, the
-    test's main cost, is spent only on the onset of the largest white-noise |z| when it is
-    over the threshold: fitted to the residuals of the augmented fit there (on the plain
-    fit's residuals a real step would count as noise and hide itself), the white-noise
-    variance a floor.
+    The steps' Gram entries are tail sums (g_k . g_l = sum of q_ci^2 from max(first_k, first_l)
+    on), so no step column is formed. The white-noise sigmas come first: a step is a
+    low-frequency regressor, so under the positively correlated residuals of flight its
+    colored sigma is larger, and where no white-noise |z| exceeds the threshold no colored one
+    does. The noise-model fit, the test's main cost, is spent only on the onset of the largest
+    white-noise |z| when it is over the threshold: fitted to the residuals of the augmented
+    fit there (on the plain fit's residuals a real step would count as noise and hide itself),
+    the white-noise variance a floor.
     """
     n, p = jac.shape
-    m = steps.shape[1]
-    x = np.column_stack([jac, steps])
-    gram, xr, rr = x.T @ x, x.T @ r, float(r @ r)
+    m = first.size
+    q2, jq, rq = (_tail(qci * qci)[first], _tail(jac * qci[:, None])[first],
+                  _tail(r * qci)[first])
+    gram = np.empty((p + m, p + m))
+    gram[:p, :p] = jac.T @ jac
+    gram[:p, p:] = jq.T
+    gram[p:, :p] = jq
+    gram[p:, p:] = q2[np.maximum.outer(np.arange(m), np.arange(m))]
+    xr, rr = np.r_[jac.T @ r, rq], float(r @ r)
     cols = [np.r_[np.arange(p), p + k] for k in range(m)]
     inv_k = [np.linalg.inv(gram[np.ix_(idx, idx)]) for idx in cols]
     coef = [mk @ xr[idx] for mk, idx in zip(inv_k, cols)]
@@ -169,13 +169,13 @@ def _scan(jac, r, steps, threshold):
     plain = sigma.copy()
     best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
     if abs(beta[best]) > threshold * sigma[best]:
-        idx = cols[best]
+        x = np.column_stack([jac, np.where(np.arange(n) >= first[best], qci, 0.0)])
         # on block means of `b` samples: the regressors are smooth over a block (the step is
         # one jump in ~N / b blocks) and the noise model is fitted to what the blocks keep, at
         # a cost independent of N
         b = max(1, int(np.ceil(n / _BLOCKS)))
-        xb = block_means(x[:, idx], b)
-        eb = block_means(r - x[:, idx] @ coef[best], b)
+        xb = block_means(x, b)
+        eb = block_means(r - x @ coef[best], b)
         cov = colored_covariance(xb, eb, window=_WINDOW, velocity=xb[:, p - 2:p]).covariance
         sigma[best] = np.sqrt(max(cov[-1, -1], sigma[best] ** 2))
     m_inv = np.linalg.inv(gram[:p, :p])
@@ -184,6 +184,11 @@ def _scan(jac, r, steps, threshold):
     return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:],
             "shift": shift[1:],
             "shift_all": shift[0], "cov_plain": float(np.mean(s2[1:])) * m_inv}
+
+
+def _tail(x):
+    """Sums from each row to the end (along the first axis)."""
+    return np.cumsum(x[::-1], axis=0)[::-1]
 
 
 def _undetected(result, model, onsets, scan, z_detect):

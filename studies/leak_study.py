@@ -116,7 +116,8 @@ def figure(summary):
         a.set_ylim(0, 1.05)
         a.set_title(f"leak {100 * leak:g}% from t = {ONSET_S:g} s" if leak else "clean flights")
         a.set_ylabel("fraction of flights")
-    ax[0, 0].legend(fontsize=8, loc="upper left")
+    handles, labels = ax[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=8, loc="outside lower center", ncols=3)
     return fig
 
 
