@@ -19,7 +19,7 @@ calm air, 0.5 and 1 m/s turbulence was 4.8, and of 40 synthetic ones 3.4, agains
 
 import numpy as np
 
-__all__ = ["ALPHA", "CENTER", "MARGIN", "MAX_HELD", "SPAN", "jump_test"]
+__all__ = ["ALPHA", "CENTER", "GAP", "MARGIN", "MAX_HELD", "SPAN", "jump_test"]
 
 # The samples on each side of a jump whose medians are compared.
 SPAN = 5
@@ -29,6 +29,8 @@ CENTER = 25
 ALPHA = 0.01
 # Standard deviations added to the Gaussian bound for the heavier tails of flight residuals.
 MARGIN = 1.0
+# A step in time longer than this many median steps is a gap: no jump is sought across it.
+GAP = 1.5
 # Above this fraction of repeated q_ci values (held or coarsely quantized samples) the
 # sample-to-sample differences have no usable scale: the test is not run.
 MAX_HELD = 0.2
@@ -61,6 +63,9 @@ def jump_test(flight):
         return None, {"skipped": "q_ci held or quantized: no sample-to-sample scale",
                       "threshold": threshold, "flagged": False}
     z1 = _standardized(np.diff(r))                   # z1[i]: r[i+1] - r[i]
+    # across a time gap the airspeed may have changed by anything: no jump there
+    dt = np.diff(flight.time_s)
+    z1[dt > GAP * np.median(dt)] = 0.0
     med = np.median(np.lib.stride_tricks.sliding_window_view(r, SPAN), axis=1)
     jump = med[SPAN:] - med[:-SPAN]                  # jump[k]: between k+SPAN-1 and k+SPAN
     zm = _standardized(jump)

@@ -158,6 +158,18 @@ def test_a_spike_is_not_a_jump(turbulent):
     assert jump_test(_leak(flight, 0.05, onset))[1]["flagged"]      # the same, lasting
 
 
+def test_no_jump_across_a_time_gap(turbulent):
+    """A 3 s gap in the record while q_ci moved 5 %: the aircraft had time, it is no jump."""
+    from pitotcal.estimation.jumps import jump_test
+
+    flight, onset = turbulent
+    later = flight.time_s >= onset
+    gapped = dataclasses.replace(_leak(flight, 0.05, onset),
+                                 time_s=np.where(later, flight.time_s + 3.0, flight.time_s))
+    assert not jump_test(gapped)[1]["flagged"]
+    assert jump_test(_leak(flight, 0.05, onset))[1]["flagged"]
+
+
 def test_held_qci_is_not_tested():
     from pitotcal.estimation.jumps import jump_test
 
