@@ -29,7 +29,7 @@ def _plain():
 
     return (mock.patch.object(robust, "gate_flight", lambda f: (f, ())),
             mock.patch.object(robust, "outliers", lambda r: np.zeros(len(r), dtype=bool)),
-            mock.patch.object(consistency, "step_test", lambda *a: (None, {})))
+            mock.patch.object(consistency, "check", lambda *a: ((), {})))
 
 
 def _time(flight, bypass):

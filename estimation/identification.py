@@ -161,8 +161,9 @@ def _fit_trimmed(flight, fit, air_data):
                 "look for a leak, a blockage or a bad channel")
         result = fit(flight.select(keep))
     kept = flight.select(keep) if not keep.all() else flight
-    step_note = consistency.step_test(kept, result, air_data)[0] if result.success else None
-    step_note = (step_note,) if step_note else ()
+    step_note, check = consistency.check(kept, result, air_data) if result.success \
+        else ((), {})
+    result = dataclasses.replace(result, consistency=check)
     if keep.all():
         return result, step_note
     return result, (

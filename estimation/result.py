@@ -60,6 +60,9 @@ class IdentificationResult:
         The flight's independent reference static pressure, when it had one (compressible):
         the prediction used it, and it separates static from total pressure error
         (`estimation.static_source`).
+    consistency : dict
+        The step-change consistency test's numbers (`estimation.consistency.step_test`
+        details; empty when it did not run): docs/interfaces.md §20.
     """
 
     model: str
@@ -87,6 +90,7 @@ class IdentificationResult:
     air_data: str = "incompressible"
     ps_pa: np.ndarray | None = None
     ps_ref_pa: np.ndarray | None = None
+    consistency: dict = field(default_factory=dict)
 
     # --- derived quantities -------------------------------------------------------------
     @property

@@ -19,6 +19,7 @@ from .budget_study import STUDY as BUDGET
 from .compare_peers import STUDY as PEERS
 from .coverage import STUDY as COVERAGE
 from .design_study import STUDY as DESIGN
+from .leak_study import STUDY as LEAK
 from .legs_flight_study import STUDY as LEGS_FLIGHT
 from .legs_study import STUDY as LEGS
 from .maneuvers_study import STUDY as MANEUVERS
@@ -38,7 +39,8 @@ log = logging.getLogger(__name__)
 # Every study, by the name it has on the command line (each a `studies.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
                                PEERS, LEGS, DESIGN, MONITOR, BUDGET,
-                               LEGS_FLIGHT, NOISE)}
+                               LEGS_FLIGHT, NOISE,
+                               LEAK)}
 
 
 class StudyInterrupted(KeyboardInterrupt):
