@@ -20,6 +20,7 @@ dependence), and the result says so.
 
 import numpy as np
 
+from pitotcal.core.information import normal_isf
 from pitotcal.core.models import delta_v_kt, get_model
 
 from .covariance import colored_covariance
@@ -88,8 +89,6 @@ def step_test(flight, result, air_data):
         ``k_shift_sigma`` the coefficients' shift in their own covariance) and ``hidden``
         (that shift exceeds `HIDDEN_RATIO` bands and `MIN_SHIFT_KT`).
     """
-    from scipy.stats import norm
-
     model = get_model(result.model)
     ch = flight_channels(flight, result.gps_noise_std_mps, air_data)
     jac = sensitivities(model, result.internal_params, *ch.args)
@@ -97,14 +96,14 @@ def step_test(flight, result, air_data):
     t = flight.time_s
     onsets = t[0] + ONSETS * (t[-1] - t[0])
     first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
-    threshold = float(norm.isf(ALPHA / (2.0 * ONSETS.size)))
+    threshold = float(normal_isf(ALPHA / (2.0 * ONSETS.size)))
     scan = _scan(jac, r, ch.qci, first, threshold)
     z = scan["beta"] / scan["sigma"]
     best = scan["best"]
     details = {"onset_s": float(onsets[best]), "step": float(-scan["beta"][best]),
                "z": float(z[best]), "threshold": threshold, "alpha": ALPHA,
                "flagged": bool(abs(z[best]) > threshold)}
-    hidden = _undetected(result, model, onsets, scan, threshold + float(norm.isf(1 - POWER)))
+    hidden = _undetected(result, model, onsets, scan, threshold + float(normal_isf(1 - POWER)))
     details.update(undetected=hidden, hidden=bool(
         hidden["dv_shift_kt"] > max(HIDDEN_RATIO * hidden["dv_2sigma_kt"], MIN_SHIFT_KT)))
     if details["flagged"]:

@@ -19,6 +19,8 @@ calm air, 0.5 and 1 m/s turbulence was 4.8, and of 40 synthetic ones 3.4, agains
 
 import numpy as np
 
+from pitotcal.core.information import normal_isf
+
 __all__ = ["ALPHA", "CENTER", "GAP", "MARGIN", "MAX_HELD", "SPAN", "jump_test"]
 
 # The samples on each side of a jump whose medians are compared.
@@ -52,11 +54,9 @@ def jump_test(flight):
         ``time_s``, ``jump_pa``, ``step`` (fraction of q_ci, q_ci low when positive),
         ``z``, ``threshold``, ``flagged``; ``skipped`` (the reason) when not run.
     """
-    from scipy.stats import norm
-
     qci = r = np.asarray(flight.qci_pa, dtype=float)
     n = r.size
-    threshold = float(norm.isf(ALPHA / (2.0 * n))) + MARGIN
+    threshold = float(normal_isf(ALPHA / (2.0 * n))) + MARGIN
     if n < 4 * SPAN:
         return None, {"skipped": "too few samples", "threshold": threshold, "flagged": False}
     if np.mean(np.diff(qci) == 0.0) > MAX_HELD:

@@ -10,6 +10,7 @@ warning per kind, naming how many and when.
 
 import numpy as np
 
+from pitotcal.core.information import normal_isf
 from pitotcal.core.units import G0_MPS2, isa_density_kgm3
 from pitotcal.io.flight_checks import PLAUSIBLE
 
@@ -114,9 +115,7 @@ def _gps_gate(flight, skip):
 
 def trim_threshold(n, rate=FALSE_TRIM_RATE):
     """|z| beyond which a sample is trimmed: `rate` clean samples per flight of `n`."""
-    from scipy.stats import norm
-
-    return float(norm.isf(rate / (2.0 * max(n, 1))))
+    return float(normal_isf(rate / (2.0 * max(n, 1))))
 
 
 def outliers(residuals_pa):
