@@ -150,3 +150,50 @@ def test_ramp_glr_rate_and_onset():
     for z in w / 0.002:
         g, m, sign = glr.update(z)
     assert g > 50 and sign < 0 and m == pytest.approx(100, abs=2)
+
+
+def test_ar2_fit_whitening_and_variance_ratio():
+    """The noise model's AR(2) fit recovers a known process; var(e)/var(w) is the closed form
+    (1 − φ2)/((1 + φ2)((1 − φ2)² − φ1²)); the monitor's innovations of it are white N(0,1)."""
+    from pitotcal.estimation.monitor_cusum import SequentialTest, design, variance_ratio
+    from pitotcal.estimation.monitor_model import _ar_fit
+
+    phi1, phi2 = 1.10, -0.15
+    rng = np.random.default_rng(3)
+    w = 0.007 * rng.standard_normal(20_000)
+    e = np.zeros(w.size)
+    for k in range(2, w.size):
+        e[k] = phi1 * e[k - 1] + phi2 * e[k - 2] + w[k]
+    phi, innov = _ar_fit(e - e.mean(), 2)
+    assert phi == pytest.approx([phi1, phi2], abs=0.02)
+    assert np.std(innov) == pytest.approx(0.007, rel=0.02)
+    closed = (1 - phi2) / ((1 + phi2) * ((1 - phi2) ** 2 - phi1 ** 2))
+    assert variance_ratio(np.array([phi1, phi2])) == pytest.approx(closed, rel=1e-9)
+    assert _ar_fit(np.cumsum(rng.standard_normal(2000)), 2) == (None, None)  # a random walk
+    noise = {"ar1": 0.95, "ar": [phi1, phi2], "innovation_rel_std": 0.007,
+             "band_log_mean": 0.0, "band_log_std": 1.0}
+    test = SequentialTest(noise, design(MonitorOptions(), 0.5), MonitorOptions())
+    z = np.array([test.step(0.5 * k, x, 0.0, True)[1] for k, x in enumerate(e[:4000])])[2:]
+    assert np.mean(z) == pytest.approx(0.0, abs=0.06) and np.std(z) == pytest.approx(1, abs=0.05)
+    assert abs(np.corrcoef(z[:-1], z[1:])[0, 1]) < 0.05
+
+
+def test_ramp_glr_ar2_is_the_brute_force_statistic():
+    """The GLR's running sums give max over onsets of (Σ g z)²/(2 Σ g²) with the AR(2) ramp
+    signature g_m = m − φ1 (m − 1)⁺ − φ2 (m − 2)⁺, computed directly."""
+    from pitotcal.estimation.monitor_glr import RampGLR
+
+    phi = np.array([1.10, -0.15])
+    z = np.random.default_rng(8).standard_normal(60)
+    glr = RampGLR(phi, 0.5)
+    for x in z:
+        got, m_best, _ = glr.update(x)
+    n = z.size
+    best = 0.0
+    for j in range(n - 3):
+        m = np.arange(1, n - j + 1)
+        g = m - phi[0] * np.maximum(m - 1, 0) - phi[1] * np.maximum(m - 2, 0)
+        lam = (g @ z[j:]) ** 2 / (2 * g @ g)
+        if lam > best:
+            best, m_ref = lam, n - j
+    assert got == pytest.approx(best, rel=1e-10) and m_best == m_ref
