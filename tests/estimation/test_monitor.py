@@ -197,3 +197,16 @@ def test_ramp_glr_ar2_is_the_brute_force_statistic():
         if lam > best:
             best, m_ref = lam, n - j
     assert got == pytest.approx(best, rel=1e-10) and m_best == m_ref
+
+
+def test_frozen_in_calm_air_is_frozen(plan, calibration):
+    """In calm air a frozen pitot keeps the transducer's noise (no gusts to lose): it shows as
+    q_ci not following the predicted speed changes, and is called frozen, not a drift; a
+    2 kt/min icing ramp in the same air stays a drift."""
+    flight, truth = simulate(plan, seed=9, rate_hz=RATE_HZ, turbulence_mps=0.0,
+                             keep_history=True)
+    frozen = monitor(apply_fault(flight, truth, Fault("blocked", 90.0, 0.0)), calibration)
+    assert [a["kind"] for a in frozen.alarms] == ["frozen"]
+    assert 0.0 <= frozen.alarms[0]["start_s"] - 90.0 <= 40.0
+    icing = monitor(apply_fault(flight, truth, Fault("icing", 90.0, 2.0)), calibration)
+    assert [a["kind"] for a in icing.alarms] == ["drift"]
