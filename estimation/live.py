@@ -3,6 +3,13 @@ arrive, and the calibration re-identified on the growing maneuver every second (
 Fig. 6, live) until its 2σ on ΔV meets a target. Whatever ends the stream — it stops, the
 connection drops, Ctrl-C — what was received is kept and the final answer is computed from it,
 the same as from a file of the same samples.
+
+The live re-identifications are warm-started (`LiveIdentifier`): one `OutputErrorProblem` is
+kept for the whole stream (its built solvers and Hessian functions reused), and IPOPT starts
+from the previous update's estimate. The problem has no constraints and no bounds, so there are
+no multipliers to carry over (IPOPT's warm_start_init_point would have nothing to use). The
+updates skip what only the final answer needs (outlier trimming and its refits, the step-change
+test): the final answer is `identify` on every sample, as offline.
 """
 
 import time
@@ -14,7 +21,7 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
 from pitotcal.io.mavlink_live import read_stream
 
-__all__ = ["LiveFix", "identify_stream", "monitor_stream"]
+__all__ = ["LiveFix", "LiveIdentifier", "identify_stream", "monitor_stream"]
 
 _MIN_IDENTIFY_S = 20.0      # no identification is tried on less than this much record
 
@@ -62,13 +69,57 @@ class LiveFix:
     target_met: bool
 
 
+class LiveIdentifier:
+    """Warm-started re-identification of a growing record (the live updates).
+
+    `update(flight)` fits `flight` (the record so far) with the problem object kept from the
+    previous updates and IPOPT started from their last converged estimate; it returns the
+    `IdentificationResult` (its coefficients, wind and colored-residual covariance as `identify`
+    computes them, without the outlier trimming and the step-change test). Model "auto" has no
+    single problem to keep: its updates are cold `identify` calls.
+
+    Parameters
+    ----------
+    model : str
+        As `identify`.
+    air : {"compressible", "incompressible"}
+        As `identify` (a record without static pressure and temperature is incompressible).
+    """
+
+    def __init__(self, model="inverse", air="compressible"):
+        from .oe import OutputErrorProblem
+
+        self.model, self.air = model, air
+        self.problem = None if model == "auto" else OutputErrorProblem(model)
+        self.start = None           # the last converged internal parameters
+
+    def update(self, flight, warm=True):
+        """The fit of `flight`; `warm=False` starts IPOPT from the linear least-squares start
+        values (the cold start, for comparison)."""
+        from . import identification, robust
+
+        if self.problem is None:
+            return identification.identify(flight, model=self.model, air=self.air)
+        air_data, _ = identification._air_data(flight, self.air)
+        identification._check_flight(flight, air_data)
+        flight, _ = robust.gate_flight(flight)
+        identification._check_track(flight)
+        result = self.problem.solve(flight, start=self.start if warm else None,
+                                    air_data=air_data)
+        if result.success:
+            self.start = np.asarray(result.internal_params, float)
+        return result
+
+
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
                     idle_timeout_s=3.0, on_fix=None, max_s=None, air="compressible"):
-    """Re-identify the growing maneuver every second; returns (final result, flight, fixes,
-    stream buffer). The final result is `identify` (with `air`) on every sample received."""
+    """Re-identify the growing maneuver every second (warm-started, `LiveIdentifier`); returns
+    (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`)
+    on every sample received, as offline."""
     from .identification import identify
 
     fixes = []
+    live = LiveIdentifier(model, air)
 
     def tick(buf):
         flight = buf.flight()
@@ -76,7 +127,7 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
             return
         start = time.perf_counter()
         try:
-            result = identify(flight, model=model, air=air)
+            result = live.update(flight)
         except PitotcalError as exc:          # too little yet (e.g. no heading change)
             if on_fix is not None:
                 on_fix(None, str(exc))

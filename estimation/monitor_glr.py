@@ -2,8 +2,9 @@
 for slow faults (icing, a creeping leak), which a fixed-reference CUSUM sees late.
 
 A ramp of the relative residual, e_k = s (t_k − τ) for t_k > τ, reaches the innovations
-w_k = e_k − a e_{k−1} (a the residual's AR(1) coefficient, `monitor_model`) as
-s Δ g_m, g_m = (1 − a) m + a, m = k − j the blocks since the onset block j. With z = w/σ_w
+w_k = e_k − Σ_i φ_i e_{k−i} (φ the residual's AR coefficients, `monitor_model`) as
+s Δ g_m, g_m = m − Σ_i φ_i max(m − i, 0), m = k − j the blocks since the onset block j:
+g_m = (1 − Σφ_i) m + Σ i φ_i once m ≥ p (for AR(1), (1 − a) m + a). With z = w/σ_w
 (N(0,1) when nothing is wrong) and the slope unknown, the log-likelihood ratio maximised over s
 and the onset (the last RAMP_WINDOW_S) is
 
@@ -41,10 +42,15 @@ class RampGLR:
     """The ramp GLR, one block at a time: `update(z)` returns (G, blocks since the best onset,
     sign of the slope)."""
 
-    def __init__(self, a, block_s):
-        self.a = float(a)
-        n = max(_MIN_BLOCKS, round(RAMP_WINDOW_S / block_s))
-        g = (1.0 - self.a) * np.arange(1, n + 1) + self.a
+    def __init__(self, phi, block_s):
+        phi = np.atleast_1d(np.asarray(phi, float))
+        n = max(_MIN_BLOCKS, round(RAMP_WINDOW_S / block_s), phi.size + 1)
+        m = np.arange(1, n + 1)
+        g = m - sum(p * np.maximum(m - i, 0) for i, p in enumerate(phi, start=1))
+        # g = slope m + offset, exactly from m = p on; `head` the first terms' departures
+        self.slope = 1.0 - float(phi.sum())
+        self.offset = float(np.sum(np.arange(1, phi.size + 1) * phi))
+        self.head = (g - (self.slope * m + self.offset))[:phi.size]
         self.energy = np.cumsum(g * g)
         self.z = deque(maxlen=n)
 
@@ -59,7 +65,9 @@ class RampGLR:
         c2 = np.concatenate([[0.0], np.cumsum(k * zz)])
         j = np.arange(0, n - _MIN_BLOCKS + 1)
         s1, s2 = c1[n] - c1[j], c2[n] - c2[j]
-        s = (1.0 - self.a) * (s2 - j * s1) + self.a * s1
+        s = self.slope * (s2 - j * s1) + self.offset * s1
+        for i, d in enumerate(self.head):     # the first p terms of g are not on the line
+            s += d * zz[j + i]
         m = n - j
         lam = s * s / (2.0 * self.energy[m - 1])
         i = int(np.argmax(lam))

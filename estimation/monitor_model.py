@@ -29,6 +29,10 @@ _MIN_PER_BLOCK = 4     # samples a block needs (the detrended variance has n - 2
 # When the calibration carries no noise model (older result JSON): correlation of 0.5-s block
 # means in the simulator's 0.5 m/s Dryden turbulence (measured, T-2 maneuver: 0.91).
 _DEFAULT_AR1 = 0.9
+# Order of the residual's autoregressive model. Block means of turbulence are smoother at short
+# lags and decorrelate faster at long ones than one AR(1) coefficient (fitted at lag one) says:
+# AR(2) follows both, and the ramp test's information grows by ~20 % (docs/measured.md).
+AR_ORDER = 2
 
 
 @dataclass(frozen=True)
@@ -168,7 +172,8 @@ def noise_model(result, block_s=BLOCK_S):
     -------
     dict
         block_s; rel_std (std of the blocks' relative residual e); ar1 (a, lag-one
-        correlation of e); innovation_rel_std (robust std of w = e_k − a e_{k−1}); band_log_mean
+        correlation of e); ar (φ_1..φ_p, least-squares AR(AR_ORDER) coefficients of e);
+        innovation_rel_std (robust std of w = e_k − Σ φ_i e_{k−i}); band_log_mean
         and band_log_std (median and robust std of log of the blocks' relative band variance);
         n_blocks.
     """
@@ -181,12 +186,25 @@ def noise_model(result, block_s=BLOCK_S):
         raise PitotcalError(f"a noise model needs >= 10 blocks of {block_s:g} s, got {e.size}")
     e = e - e.mean()
     a = float(np.clip(np.corrcoef(e[:-1], e[1:])[0, 1], 0.0, 0.98))
-    w = e[1:] - a * e[:-1]
+    phi, w = _ar_fit(e, AR_ORDER)
+    if phi is None:                    # not stationary: the lag-one AR(1)
+        phi, w = [a], e[1:] - a * e[:-1]
     log_band = np.log(blocks.band_rel_var)
-    return {"block_s": block_s, "rel_std": float(np.std(e)), "ar1": a,
+    return {"block_s": block_s, "rel_std": float(np.std(e)), "ar1": a, "ar": list(phi),
             "innovation_rel_std": _robust_std(w),
             "band_log_mean": float(np.median(log_band)), "band_log_std": _robust_std(log_band),
             "n_blocks": int(e.size)}
+
+
+def _ar_fit(e, p):
+    """Least-squares AR(p) coefficients of `e` and its innovations; (None, None) when the fit is
+    not stationary (a root of 1 − Σ φ_i z^i inside the unit circle)."""
+    x = np.column_stack([e[p - i:e.size - i] for i in range(1, p + 1)])
+    phi, *_ = np.linalg.lstsq(x, e[p:], rcond=None)
+    roots = np.roots(np.concatenate([-phi[::-1], [1.0]]))
+    if np.any(np.abs(roots) <= 1.0 / 0.995):
+        return None, None
+    return [float(v) for v in phi], e[p:] - x @ phi
 
 
 def _robust_std(x):

@@ -71,7 +71,7 @@ class BlockLoop:
         pred, grad = _predict_block(self.cal, inputs, j, wind.wind)
         e = (blocks.qci_pa[j] - pred) / pred
         fired, z, y = test.step(t, e, np.log(max(blocks.band_rel_var[j], 1e-30)), learning)
-        r_var = (pred * np.sqrt(test.sw2 / max(1.0 - test.a ** 2, 1e-3))) ** 2
+        r_var = pred * pred * test.sw2 * test.e_var_ratio
         if not learning and not self.settled:
             wind.settle(grad, r_var, self.block_s, opts.wind_tau_s)
             self.settled = True

@@ -34,7 +34,9 @@ CONDITIONS = {
                    "wind_drift_mps2": (0.004, -0.004)},
 }
 FAULT_CONDITIONS = ("calm", "turb-0.5", "turb-1.0")
-EXTRA_CLEAN_1MPS = 3          # clean-only flights in 1 m/s per run of the grid
+# clean-only flights per condition per run of the grid: at 30 runs, 210 flights and 12.25
+# monitored hours per condition (the issue asks for < 1 false alarm per 10 flight-hours)
+EXTRA_CLEAN = 6
 # (kind, size, the classification that is right for it)
 FAULTS = (("blocked", 0.0, "frozen"), ("blocked", 3.0, "drain"),
           ("leak", 0.02, "step"), ("leak", 0.05, "step"), ("leak", 0.1, "step"),
@@ -114,9 +116,9 @@ def cases(runs, quick):
                 for r in range(runs)]
     grid = [{"condition": c, "faults": FAULTS if c in FAULT_CONDITIONS else (),
              "seed_offset": r} for c in CONDITIONS for r in range(runs)]
-    # the false-alarm target is for 1 m/s: more hours there, clean only (cheap)
-    return grid + [{"condition": "turb-1.0", "faults": (), "seed_offset": runs + r}
-                   for r in range(EXTRA_CLEAN_1MPS * runs)]
+    # false alarms need hours: more clean-only flights (cheap) in every condition
+    return grid + [{"condition": c, "faults": (), "seed_offset": runs + r}
+                   for c in CONDITIONS for r in range(EXTRA_CLEAN * runs)]
 
 
 def summarize(rows, cases=None):
