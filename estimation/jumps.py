@@ -21,7 +21,7 @@ import numpy as np
 
 from pitotcal.core.information import normal_isf
 
-__all__ = ["ALPHA", "CENTER", "GAP", "MARGIN", "MAX_HELD", "SPAN", "jump_test"]
+__all__ = ["ALPHA", "CENTER", "GAP", "MARGIN", "MAX_HELD", "MIN_STEP", "SPAN", "jump_test"]
 
 # The samples on each side of a jump whose medians are compared.
 SPAN = 5
@@ -31,6 +31,10 @@ CENTER = 25
 ALPHA = 0.01
 # Standard deviations added to the Gaussian bound for the heavier tails of flight residuals.
 MARGIN = 1.0
+# Smallest jump named, as a fraction of q_ci (0.5 % of airspeed): on a quiet transducer a jump
+# of a few tenths of a pascal stands far above the noise (z = -39 for -0.3 Pa on a simulated
+# leg flight), but it moves no calibration; the leaks that matter are a few percent.
+MIN_STEP = 0.01
 # A step in time longer than this many median steps is a gap: no jump is sought across it.
 GAP = 1.5
 # Above this fraction of repeated q_ci values (held or coarsely quantized samples) the
@@ -77,7 +81,7 @@ def jump_test(flight):
     step = float(-jump[k] / qci[at])
     details = {"time_s": float(flight.time_s[at]), "jump_pa": float(jump[k]), "step": step,
                "z": float(np.sign(zm[k]) * stat[k]), "threshold": threshold,
-               "flagged": bool(stat[k] > threshold)}
+               "flagged": bool(stat[k] > threshold and abs(step) >= MIN_STEP)}
     if not details["flagged"]:
         return None, details
     side = "low" if step > 0 else "high"

@@ -170,6 +170,21 @@ def test_no_jump_across_a_time_gap(turbulent):
     assert jump_test(_leak(flight, 0.05, onset))[1]["flagged"]
 
 
+def test_a_tiny_jump_on_a_quiet_transducer_is_not_named():
+    """0.3 Pa (0.03 % of q_ci) stands ~50 sigma above 0.01 Pa of noise, but moves nothing:
+    below MIN_STEP it is not named; 3 % on the same flight is."""
+    from pitotcal.estimation.jumps import MIN_STEP, jump_test
+
+    flight, _ = synthetic_flight(seed=4, n=6000, qc_noise_pa=0.01)
+    onset = float(flight.time_s[3000])
+    tiny = flight.qci_pa - np.where(flight.time_s >= onset, 0.3, 0.0)
+    details = jump_test(dataclasses.replace(flight, qci_pa=tiny))[1]
+    assert abs(details["z"]) > details["threshold"] and abs(details["step"]) < MIN_STEP
+    assert not details["flagged"]
+    details = jump_test(_leak(flight, 0.03, onset))[1]
+    assert details["flagged"] and details["time_s"] == pytest.approx(onset, abs=0.05)
+
+
 def test_held_qci_is_not_tested():
     from pitotcal.estimation.jumps import jump_test
 
