@@ -38,8 +38,8 @@ ALPHA = 0.01
 POWER = 0.95
 # Hidden when the step detected at POWER moves ΔV by more than this many times its 2-sigma
 # band: a step at mid-flight of a maneuver flown as two passes over the same speeds is
-# detected at (threshold + z_POWER) sigma_s = 4.9 sigma_s and leaves the fit halfway, at about
-# 2.45 bands; a one-way sweep hides it at 4-6 (docs/measured.md).
+# detected at (threshold + z_POWER) sigma_s = 5.0 sigma_s and leaves the fit halfway, at about
+# 2.5 bands; a one-way sweep hides it at 4-6 (docs/measured.md).
 HIDDEN_RATIO = 3.0
 # ... and by more than this, kt: below what an airspeed indicator shows.
 MIN_SHIFT_KT = 0.1
@@ -128,7 +128,8 @@ def hidden_warning(source, details):
             f"{hidden['onset_s']:.0f} s on is caught in {100 * POWER:.0f}% of flights only from "
             f"{100 * hidden['step']:.1f}% up, and one of that size moves dV by "
             f"{hidden['dv_shift_kt']:.2f} kt at {hidden['vi_kt']:.0f} kt, "
-            f"{hidden['dv_shift_kt'] / hidden['dv_2sigma_kt']:.1f} times its 2-sigma band; fly "
+            f"{hidden['dv_shift_kt'] / hidden['dv_2sigma_reported_kt']:.1f} times the 2-sigma "
+            "band the result reports there; fly "
             "the speeds twice (plan --return: up and back down the speed range) to tell the "
             "two apart")
 
@@ -217,7 +218,8 @@ def _undetected(result, model, onsets, scan, z_detect):
     ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
     inflation = float(np.median(ratio)) if ratio.size else 1.0
     cov_k = inflation * scan["cov_plain"][:nk, :nk]
-    vi = np.array([row["vi_kt"] for row in result.correction_table()], dtype=float)
+    rows = result.correction_table()
+    vi = np.array([row["vi_kt"] for row in rows], dtype=float)
     dv_fit = delta_v_kt(model, k, vi, result.air_data)
     grad = gradient(lambda kk: delta_v_kt(model, kk, vi, result.air_data), k)
     band = np.maximum(2.0 * sigma_of(grad, cov_k), 1e-12)
@@ -235,5 +237,7 @@ def _undetected(result, model, onsets, scan, z_detect):
             best = (dv[j] / band[j], {
                 "onset_s": float(onset), "step": float(size), "power": POWER,
                 "dv_shift_kt": float(dv[j]), "dv_2sigma_kt": float(band[j]),
-                "vi_kt": float(vi[j]), "k_shift_sigma": k_sigma})
+                "vi_kt": float(vi[j]), "k_shift_sigma": k_sigma,
+                # the band printed in the result's table at that speed (the warning's ratio)
+                "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"])})
     return best[1]

@@ -66,21 +66,23 @@ def jump_test(flight):
     if np.mean(np.diff(qci) == 0.0) > MAX_HELD:
         return None, {"skipped": "q_ci held or quantized: no sample-to-sample scale",
                       "threshold": threshold, "flagged": False}
-    z1 = _standardized(np.diff(r))                   # z1[i]: r[i+1] - r[i]
-    # across a time gap the airspeed may have changed by anything: no jump there
+    # across a time gap the airspeed may have changed by anything: no jump there, and the
+    # gap's difference is kept out of every running mean and scale
     dt = np.diff(flight.time_s)
-    z1[dt > GAP * np.median(dt)] = 0.0
+    ok = dt <= GAP * np.median(dt)
+    z1 = _standardized(np.diff(r), ok)               # z1[i]: r[i+1] - r[i]
     med = np.median(np.lib.stride_tricks.sliding_window_view(r, SPAN), axis=1)
     jump = med[SPAN:] - med[:-SPAN]                  # jump[k]: between k+SPAN-1 and k+SPAN
-    zm = _standardized(jump)
+    straddles = np.convolve(~ok, np.ones(2 * SPAN - 1), "valid")[:jump.size] > 0
+    zm = _standardized(jump, ~straddles)
     i = np.arange(SPAN - 1, SPAN - 1 + zm.size)      # the same jump's index in z1
     a = z1[i]
     stat = np.where(np.sign(a) == np.sign(zm), np.minimum(np.abs(a), np.abs(zm)), 0.0)
     k = int(np.argmax(stat))
     at = i[k] + 1                                    # first sample after the jump
-    step = float(-jump[k] / qci[at])
+    step = float(-jump[k] / med[k])                  # against the median before the jump
     details = {"time_s": float(flight.time_s[at]), "jump_pa": float(jump[k]), "step": step,
-               "z": float(np.sign(zm[k]) * stat[k]), "threshold": threshold,
+               "z": float(np.sign(jump[k]) * stat[k]), "threshold": threshold,
                "flagged": bool(stat[k] > threshold and abs(step) >= MIN_STEP)}
     if not details["flagged"]:
         return None, details
@@ -92,12 +94,15 @@ def jump_test(flight):
             "before and after it apart (--start-s, --end-s)"), details
 
 
-def _standardized(d):
-    """(d - its running mean over 2 CENTER + 1) / (1.4826 MAD): a robust z, unmoved by the few
-    jumps sought; the running mean takes out the airspeed's own rate of change."""
+def _standardized(d, ok):
+    """(d - its running mean over 2 CENTER + 1) / (1.4826 MAD) where `ok`, 0 elsewhere: a
+    robust z, unmoved by the few jumps sought; the running mean takes out the airspeed's own
+    rate of change, and the entries not `ok` (across a time gap) enter neither."""
+    d = np.where(ok, d, 0.0)
     c = np.concatenate([[0.0], np.cumsum(d)])
+    w = np.concatenate([[0], np.cumsum(ok)])
     lo = np.clip(np.arange(d.size) - CENTER, 0, d.size)
     hi = np.clip(np.arange(d.size) + CENTER + 1, 0, d.size)
-    d = d - (c[hi] - c[lo]) / (hi - lo)
-    mad = 1.4826 * float(np.median(np.abs(d)))
-    return d / mad if mad > 0 else np.zeros_like(d)
+    d = d - (c[hi] - c[lo]) / np.maximum(w[hi] - w[lo], 1)
+    mad = 1.4826 * float(np.median(np.abs(d[ok]))) if ok.any() else 0.0
+    return np.where(ok, d / mad, 0.0) if mad > 0 else np.zeros_like(d)

@@ -85,7 +85,7 @@ def test_stated_shift_is_what_a_refit_does(sweep):
 
 def test_flown_up_and_down_does_not_warn():
     """Two passes over the speeds: a step at mid-flight leaves the fit halfway, at about
-    (threshold + z_power) / 2 = 2.45 bands, below HIDDEN_RATIO."""
+    (threshold + z_power) / 2 = 2.50 bands, below HIDDEN_RATIO."""
     flight, _ = _two_pass(seed=4, turbulence_mps=0.5, gps_rate_hz=5.0, gps_noise_mps=0.1)
     result = _fit(flight)
     ratio = result.consistency["undetected"]["dv_shift_kt"] \
@@ -183,6 +183,27 @@ def test_a_tiny_jump_on_a_quiet_transducer_is_not_named():
     assert not details["flagged"]
     details = jump_test(_leak(flight, 0.03, onset))[1]
     assert details["flagged"] and details["time_s"] == pytest.approx(onset, abs=0.05)
+
+
+def test_samples_missing_for_a_while_are_no_jump():
+    """A record with 30-60 % of it missing (a dropped stream): the airspeed moved meanwhile;
+    neither the gap nor its neighbours may read as a jump (the running means and scales skip
+    it), and a 3 % leak after such a gap is still named."""
+    from pitotcal.estimation.jumps import jump_test
+
+    flight, _ = synthetic_flight(seed=2, n=12000, turbulence_mps=0.5, gps_rate_hz=5.0,
+                                 gps_noise_mps=0.1)
+    for a, b in ((0.2, 0.5), (0.1, 0.9)):
+        keep = np.ones(flight.n, dtype=bool)
+        keep[int(a * flight.n):int(b * flight.n)] = False
+        details = jump_test(flight.select(keep))[1]
+        assert not details["flagged"] and abs(details["z"]) < details["threshold"], (a, b)
+    keep = np.ones(flight.n, dtype=bool)
+    keep[2000:4000] = False
+    onset = float(flight.time_s[8000])
+    details = jump_test(_leak(flight, 0.03, onset).select(keep))[1]
+    assert details["flagged"] and details["time_s"] == pytest.approx(onset, abs=0.05)
+    assert details["z"] < 0 and details["step"] == pytest.approx(0.03, abs=0.01)
 
 
 def test_held_qci_is_not_tested():
