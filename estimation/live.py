@@ -84,12 +84,19 @@ class LiveIdentifier:
         As `identify`.
     air : {"compressible", "incompressible"}
         As `identify` (a record without static pressure and temperature is incompressible).
+    gps_error : dict, optional
+        `identify`'s ``gps_error_sigma_mps`` and ``gps_error_tau_s`` (the receiver's stated
+        slow velocity error), counted in every update's bounds.
     """
 
-    def __init__(self, model="inverse", air="compressible"):
+    def __init__(self, model="inverse", air="compressible", gps_error=None):
+        from .identification import _gps_error
         from .oe import OutputErrorProblem
 
         self.model, self.air = model, air
+        self.gps_error = dict(gps_error or {})
+        self._stated = _gps_error(self.gps_error.get("gps_error_sigma_mps"),
+                                  self.gps_error.get("gps_error_tau_s"))
         self.problem = None if model == "auto" else OutputErrorProblem(model)
         self.start = None           # the last converged internal parameters
 
@@ -99,27 +106,30 @@ class LiveIdentifier:
         from . import identification, robust
 
         if self.problem is None:
-            return identification.identify(flight, model=self.model, air=self.air)
+            return identification.identify(flight, model=self.model, air=self.air,
+                                           **self.gps_error)
         air_data, _ = identification._air_data(flight, self.air)
         identification._check_flight(flight, air_data)
         flight, _ = robust.gate_flight(flight)
         identification._check_track(flight)
         result = self.problem.solve(flight, start=self.start if warm else None,
-                                    air_data=air_data)
+                                    air_data=air_data, gps_error=self._stated)
         if result.success:
             self.start = np.asarray(result.internal_params, float)
         return result
 
 
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
-                    idle_timeout_s=3.0, on_fix=None, max_s=None, air="compressible"):
+                    idle_timeout_s=3.0, on_fix=None, max_s=None, air="compressible",
+                    gps_error=None):
     """Re-identify the growing maneuver every second (warm-started, `LiveIdentifier`); returns
-    (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`)
-    on every sample received, as offline."""
+    (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`
+    and the stated `gps_error`, as `LiveIdentifier` takes it) on every sample received, as
+    offline. A bad `gps_error` is refused before the stream is opened."""
     from .identification import identify
 
     fixes = []
-    live = LiveIdentifier(model, air)
+    live = LiveIdentifier(model, air, gps_error)
 
     def tick(buf):
         flight = buf.flight()
@@ -140,7 +150,7 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
     buf = read_stream(source, oat_k=oat_k, idle_timeout_s=idle_timeout_s, on_tick=tick,
                       max_s=max_s)
     flight = buf.flight()
-    result = identify(flight, model=model, air=air)
+    result = identify(flight, model=model, air=air, **live.gps_error)
     return result, flight, fixes, buf
 
 

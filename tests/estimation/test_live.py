@@ -38,3 +38,20 @@ def test_auto_updates_are_identify():
     assert live.problem is None
     np.testing.assert_allclose(got.params, identify(flight, model="auto",
                                                     air="incompressible").params)
+
+
+def test_a_stated_gps_error_reaches_the_live_bounds(flight_truth):
+    """The receiver's stated slow error (issue 11) counts in every live update as offline, and a
+    bad one is refused naming its parameter before any stream is read."""
+    from pitotcal.core.errors import PitotcalError
+
+    flight, _ = flight_truth
+    stated = {"gps_error_sigma_mps": 1.0, "gps_error_tau_s": 60.0}
+    live = LiveIdentifier("inverse", air="incompressible", gps_error=stated).update(flight)
+    offline = identify(flight, air="incompressible", **stated)
+    plain = identify(flight, air="incompressible")
+    np.testing.assert_allclose(live.std, offline.std, rtol=1e-4)
+    assert live.std[2] > 1.1 * plain.std[2]            # the wind's bound grows
+    with pytest.raises(PitotcalError, match="gps_error_sigma_mps"):
+        LiveIdentifier("inverse", gps_error={"gps_error_sigma_mps": float("nan"),
+                                             "gps_error_tau_s": 30.0})

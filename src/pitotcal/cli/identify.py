@@ -291,11 +291,17 @@ def _write_json(path, result, flight, source, budget=None, gps_error=None):
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
     out.update(_monitor_noise_model(result))
-    if gps_error is not None:       # issue 11: the stated GPS error the bounds count
-        stated = gps_error["gps_error_sigma_mps"] is not None
-        out["gps_error"] = {"stated": stated, "sigma_mps": gps_error["gps_error_sigma_mps"],
-                            "tau_s": gps_error["gps_error_tau_s"]}
+    out.update(_gps_error_record(gps_error))
     write_json(path, out)
+
+
+def _gps_error_record(gps_error):
+    """JSON "gps_error": the stated GPS error the bounds count (issue 11), or nothing."""
+    if gps_error is None:
+        return {}
+    return {"gps_error": {"stated": gps_error["gps_error_sigma_mps"] is not None,
+                          "sigma_mps": gps_error["gps_error_sigma_mps"],
+                          "tau_s": gps_error["gps_error_tau_s"]}}
 
 
 def _monitor_noise_model(result):
@@ -347,7 +353,7 @@ def _run_live(args):
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
         oat_k=oat_k_from_c(args.oat_c), idle_timeout_s=positive("idle_s", args.idle_s),
-        on_fix=show, air=args.air)
+        on_fix=show, air=args.air, gps_error=_gps_error(args))
     print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
     print(result.summary())
@@ -358,6 +364,7 @@ def _run_live(args):
             "target_met_at_s": met[0] if met else None, "stream_ended": buf.stopped,
             "max_update_s": max((f.update_s for f in fixes), default=None)}}
         out["warnings"] = list(out.get("warnings", [])) + list(flight.warnings)
+        out.update(_gps_error_record(_gps_error(args)))
         write_json(args.json, out)
         print(f"\nWrote {args.json}")
     if args.plot is not None:
