@@ -17,7 +17,7 @@ from .common import column, fly, ok_rows, percent, score, truth_for
 from .figures import new_figure, save
 from .study import MonteCarloStudy
 
-__all__ = ["PARAMETERS", "STUDY", "TURBULENCE_MPS", "run_scored"]
+__all__ = ["PARAMETERS", "STUDY", "TURBULENCE_MPS", "run_scored", "wilson_interval"]
 
 PARAMETERS = ("k1", "k2", "wind_speed_mps", "wind_from_deg")
 TURBULENCE_MPS = 1.0     # moderate: where plain bounds are known to be too small (docs/measured.md)
@@ -69,7 +69,7 @@ def summarize(rows, cases=None):
     allin, allin_plain = np.concatenate(inside), np.concatenate(inside_plain)
     out["coverage_2sigma"] = _frac(allin)
     out["coverage_2sigma_uncorrected"] = _frac(allin_plain)
-    out["coverage_2sigma_interval95"] = _wilson(allin)
+    out["coverage_2sigma_interval95"] = wilson_interval(allin)
     out["coverage_dv_2sigma"] = _frac(column(good, "dv_inside_2sigma")[
         np.isfinite(column(good, "dv_inside_2sigma"))] >= 1.0)
     out["n_intervals"] = int(allin.size)
@@ -91,7 +91,7 @@ def _frac(mask):
     return float(mask.mean()) if mask.size else None
 
 
-def _wilson(mask, z=1.96):
+def wilson_interval(mask, z=1.96):
     """95% Wilson interval of a fraction: how far the Monte Carlo coverage itself can be off."""
     n = np.asarray(mask).size
     if n == 0:

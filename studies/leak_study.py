@@ -12,7 +12,7 @@ range, and how often it does so with no warning from the checks (a tight wrong a
 import numpy as np
 
 from .common import column, fly, identify_flight, ok_rows, percent, score, truth_for
-from .coverage import _wilson
+from .coverage import wilson_interval
 from .figures import new_figure, save
 from .study import MonteCarloStudy
 
@@ -77,7 +77,7 @@ def case_summary(good):
                  "silent_wrong"):
         x = column(good, name) > 0.5
         out[name] = float(np.mean(x))
-        out[f"{name}_interval95"] = _wilson(x)
+        out[f"{name}_interval95"] = wilson_interval(x)
     out["median_undetected_step"] = float(np.nanmedian(column(good, "undetected_step")))
     return out
 

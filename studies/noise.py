@@ -18,7 +18,7 @@ against it are kept as ``P_z_flown`` (they are smaller: the bounds look 1.3-1.6x
 import numpy as np
 
 from .common import column, ok_rows, percent
-from .coverage import PARAMETERS, _wilson, run_scored
+from .coverage import PARAMETERS, run_scored, wilson_interval
 from .figures import new_figure, save
 from .study import MonteCarloStudy
 
@@ -66,7 +66,7 @@ def case_summary(good):
         std = column(good, f"{name}_std")
         zs.append(z)
         params[name] = {"coverage_2sigma": float(np.mean(np.abs(z) <= 2.0)) if z.size else None,
-                        "coverage_2sigma_interval95": _wilson(np.abs(z) <= 2.0),
+                        "coverage_2sigma_interval95": wilson_interval(np.abs(z) <= 2.0),
                         "rms_z": float(np.sqrt(np.mean(z ** 2))) if z.size else None,
                         "median_2sigma": float(2.0 * np.nanmedian(std)), "n": int(z.size)}
         flown = column(good, f"{name}_z_flown")

@@ -31,7 +31,7 @@ def add_parser(subparsers):
                         "$PITOTCAL_ALFA_DATA, else ./alfa-carbonz)")
     p.add_argument("--engine", default="own", choices=("own", "jsbsim"),
                    help="flight model of the simulated runs: own (default) or jsbsim "
-                        "(JSBSim's c172x; coverage only)")
+                        "(JSBSim's c172x; the coverage and noise studies)")
     p.add_argument("--run-index", type=int, default=None, metavar="I",
                    help="repeat run I alone (same --runs/--seed/--quick as the study); "
                         "prints its rows as JSON")

@@ -18,7 +18,7 @@ disturbance reaching q_ci through the wind sensitivities w_i (the last two colum
 along-path gust g_i as |w_i| g_i and the GPS velocity noise as white noise of variance
 |w_i|^2 sigma_gps^2, plus the transducer's white noise; `reported_covariance` widens the
 sandwich for the degrees of freedom of a noise model fitted to one record, as `identify` does
-(Student-t at N / tau, `estimation.covariance.student_t_widening`).
+(Student-t at N / tau, `student_t_widening`, which the estimator imports from here).
 
 numpy only; no import of maneuvers or estimation (layers).
 """
@@ -260,7 +260,7 @@ def normal_isf(p):
 
 def student_t_widening(dof, z=2.0):
     """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
-    dof >= 3); 1 for infinite dof. The same expansion as `estimation.covariance`."""
+    dof >= 3); 1 for infinite dof. The estimator's widening too (`estimation.covariance`)."""
     if not np.isfinite(dof):
         return 1.0
     v = max(float(dof), 3.0)
