@@ -274,7 +274,8 @@ def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, 
         air_sensors=_checked_air_sensors(sensors),
         gps_gm_sigma_mps=_limited("gps_gm_sigma_mps", gps_gm_sigma_mps),
         gps_gm_tau_s=positive("gps_gm_tau_s", gps_gm_tau_s),
-        vertical_gusts=_flag("vertical_gusts", vertical_gusts))
+        # recorded as flown: no turbulence, no vertical gust (turbulence_mps checked above)
+        vertical_gusts=_flag("vertical_gusts", vertical_gusts) and float(turbulence_mps) > 0)
     span_s = float(plan.time_s[-1] - plan.time_s[0])
     _check_samples(opts.rate_hz, span_s)
     _check_pressure_error(opts, plan)
