@@ -64,7 +64,8 @@ class DemoResult:
 
 def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"],
              rate_hz=DEMO_SIM["rate_hz"]):
-    """Plan, fly and identify the T-2 case; write plan, flight, result and figures to `out_dir`.
+    """Plan, fly and identify the T-2 case (with the GUM uncertainty budget, as `pitotcal identify`
+    gives it); write plan, flight, result and figures to `out_dir`.
 
     Parameters
     ----------
@@ -82,9 +83,12 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     import time
 
     from pitotcal.estimation import identify
+    from pitotcal.estimation.budget import uncertainty_budget
+    from pitotcal.estimation.budget_report import add_budget
     from pitotcal.maneuvers import plan_maneuver, simulate, write_truth_json
 
     from pitotcal.io import write_flight_csv, write_plan
+    from pitotcal.io.jsonfile import json_ready
 
     duration_s, rate_hz = positive("duration_s", duration_s), positive("rate_hz", rate_hz)
     out = output_folder(out_dir, "the plan, flight, result and figures")
@@ -98,6 +102,9 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     t0 = time.perf_counter()
     result = identify(flight, model="inverse")
     clock["identify"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    budget = uncertainty_budget(flight, result)       # the GUM budget, as `identify` gives it
+    clock["budget"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     files = {"plan_csv": out / "plan.csv", "flight_csv": out / "flight.csv",
@@ -110,7 +117,7 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     doc = result.to_dict()
     doc["truth"] = {"model": truth.model, "parameters": truth.parameters}
     doc["demo_table"] = table
-    write_json(files["result_json"], doc)
+    write_json(files["result_json"], json_ready(add_budget(doc, budget)))
     files["plan_png"] = _plan_figure(plan, out)
     files["calibration_png"] = out / "calibration.png"
     result.plot(files["calibration_png"])
