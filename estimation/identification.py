@@ -105,7 +105,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0)
     ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
     checks.choice("air", air, AIR_DATA_MODES)
-    gps_error = _gps_error(gps_error_sigma_mps, gps_error_tau_s)
+    gps_error = _gps_error(gps_error_sigma_mps, gps_error_tau_s, flight)
     air_data, air_note = _air_data(flight, air)
     _check_flight(flight, air_data)
     flight, gate_note = robust.gate_flight(flight)
@@ -126,9 +126,10 @@ def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data, 
     return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error)
 
 
-def _gps_error(sigma_mps, tau_s):
+def _gps_error(sigma_mps, tau_s, flight=None):
     """(sigma_mps, tau_s) of a stated Gauss-Markov GPS velocity error, or None; both or
-    neither given."""
+    neither given; tau no shorter than the `flight`'s sample interval (a faster error is
+    white noise, which the fit measures itself)."""
     if sigma_mps is None and tau_s is None:
         return None
     if sigma_mps is None or tau_s is None:
@@ -136,7 +137,14 @@ def _gps_error(sigma_mps, tau_s):
         raise PitotcalError(f"{missing}: state the GPS velocity error's sigma and correlation "
                             "time together", param=missing)
     sigma = checks.number("gps_error_sigma_mps", sigma_mps, 0.0, 10.0)
-    return sigma, checks.positive("gps_error_tau_s", tau_s)
+    tau = checks.positive("gps_error_tau_s", tau_s)
+    dt = float(np.median(np.diff(flight.time_s))) if flight is not None and flight.n > 1 else 0.0
+    if tau < dt:
+        raise PitotcalError(f"gps_error_tau_s {tau:g} s is shorter than the sample interval "
+                            f"({dt:g} s): an error that fast is white noise, which the fit "
+                            f"measures itself; state a correlation time of at least {dt:g} s",
+                            param="gps_error_tau_s")
+    return sigma, tau
 
 
 def _fit_trimmed(flight, fit, air_data):

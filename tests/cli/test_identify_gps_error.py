@@ -48,3 +48,16 @@ def test_half_or_bad_statement_refused(flight_csv, capsys, extra, match):
     assert main(["identify", str(path), *extra]) == 2
     err = capsys.readouterr().err
     assert match in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_correlation_time_below_the_sample_interval_is_refused():
+    """A 'slow' error faster than the samples is white noise: refused naming the flag and the
+    interval, not silently clamped (review finding)."""
+    from pitotcal.estimation import identify
+
+    from pitotcal.core.errors import PitotcalError
+
+    flight, _ = synthetic_flight(seed=1, n=2000)
+    with pytest.raises(PitotcalError, match="shorter than the sample interval") as err:
+        identify(flight, air="incompressible", gps_error_sigma_mps=0.05, gps_error_tau_s=1e-9)
+    assert err.value.param == "gps_error_tau_s"
