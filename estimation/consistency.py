@@ -94,7 +94,8 @@ def step_test(flight, result, air_data):
     jac = sensitivities(model, result.internal_params, *ch.args)
     r = result.residuals_pa
     t = flight.time_s
-    onsets = t[0] + ONSETS * (t[-1] - t[0])
+    # each onset at the first sample from its fraction of the record on (never inside a gap)
+    onsets = t[np.searchsorted(t, t[0] + ONSETS * (t[-1] - t[0]))]
     first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
     threshold = float(normal_isf(ALPHA / (2.0 * ONSETS.size)))
     scan = _scan(jac, r, ch.qci, first, threshold)
