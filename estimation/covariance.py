@@ -174,16 +174,20 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     # The noise model is fitted to one record: its long-run variance has few degrees of
     # freedom (T / (4 tau) for one exponential, `noise_model.DOF_TAUS`): Student-t widening.
     cov = cov * student_t_widening(dof) ** 2
-    # correlation time, samples: of the fitted decay, or half the window
+    return ColoredCovariance(cov, lag, window, a, _few_stretches(n, window, a, lag), dof)
+
+
+def _few_stretches(n, window, a, lag):
+    """The warning when the record holds fewer than MIN_STRETCHES correlation times, else
+    None; the correlation time is the fitted decay's, or half the lag window."""
     tau = (-1.0 / np.log(a) if window in ("exponential", "multiscale") and 0.0 < a < 1.0
            else lag / 2.0)
     stretches = n / max(2.0 * tau, 1.0)
-    warning = None
-    if stretches < MIN_STRETCHES:
-        warning = (f"residuals correlated over ~{2 * tau:.0f} samples: only ~{stretches:.0f} "
-                   "independent stretches of data, so the corrected bounds are themselves "
-                   f"uncertain by ~{100 / np.sqrt(max(stretches, 1.0)):.0f}%; fly longer")
-    return ColoredCovariance(cov, lag, window, a, warning, dof)
+    if stretches >= MIN_STRETCHES:
+        return None
+    return (f"residuals correlated over ~{2 * tau:.0f} samples: only ~{stretches:.0f} "
+            "independent stretches of data, so the corrected bounds are themselves "
+            f"uncertain by ~{100 / np.sqrt(max(stretches, 1.0)):.0f}%; fly longer")
 
 
 def _exponential_acov(residuals, jac):

@@ -84,15 +84,8 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     A solver that does not converge is not an exception: `success` is False, `message` is
     IPOPT's status and `warnings` says so.
 
-    "auto" uses the Bayesian information criterion with an effective sample size,
-    BIC = N_eff ln(RSS / N) + p ln(N_eff), N_eff = N median_j(P_jj / C_jj) clipped to [1, N],
-    P the plain and C the colored-residual covariance of the lowest-RSS candidate, in the
-    solver's parameters: N divided by the variance inflation the reported bounds carry, so
-    the criterion and the bounds use one noise model. At 50 Hz the residuals are correlated
-    over hundreds of samples; the plain N would reward any extra coefficient that fits
-    turbulence. (A Bartlett long-run variance of the residuals, the earlier N_eff, made the
-    same choices on the test flights but counted about twice as many samples in turbulence,
-    because its taper underestimates the long-run variance.)
+    "auto" uses the Bayesian information criterion with an effective sample size (see
+    `_identify_auto`).
 
     Example
     -------
@@ -182,7 +175,17 @@ def _fit_trimmed(flight, fit, air_data):
 
 
 def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data, gps_error=None):
-    """Every structure in MODELS, the one with the lowest BIC kept (see `identify` Notes)."""
+    """Every structure in MODELS, the one with the lowest BIC kept.
+
+    BIC = N_eff ln(RSS / N) + p ln(N_eff), N_eff = N median_j(P_jj / C_jj) clipped to [1, N],
+    P the plain and C the colored-residual covariance of the lowest-RSS candidate, in the
+    solver's parameters: N divided by the variance inflation the reported bounds carry, so
+    the criterion and the bounds use one noise model. At 50 Hz the residuals are correlated
+    over hundreds of samples; the plain N would reward any extra coefficient that fits
+    turbulence. (A Bartlett long-run variance of the residuals, the earlier N_eff, made the
+    same choices on the test flights but counted about twice as many samples in turbulence,
+    because its taper underestimates the long-run variance.)
+    """
     results, candidates = {}, []
     for name in MODELS:
         try:
@@ -310,7 +313,7 @@ def _check_information(result):
 
 
 def _effective_n(result):
-    """N / the variance inflation of the colored-residual covariance (see `identify` Notes).
+    """N / the variance inflation of the colored-residual covariance (see `_identify_auto`).
 
     Falls back to the residuals' Bartlett long-run variance ratio when the covariance has no
     finite positive diagonal (a solve that did not converge).
