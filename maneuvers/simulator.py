@@ -349,11 +349,9 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         GPS velocity: update rate (Hz, sample-and-hold in between; 0 = every sample), white
         noise std per component and update (m/s), age of the reported velocity (s).
     air_data : {"incompressible", "compressible"}
-        True impact pressure from the true airspeed: ½ρV_t² (the paper's eq. 2, the default)
-        or isentropic, q_c = p_s[(1 + 0.2M²)^3.5 − 1] with the ISA static pressure and
-        temperature at the altitude flown (pitotcal.core.airdata), of which rho_kgm3 is made.
-        Compressible flights also carry `ps_pa` (the static port: p_s + q_c − q_ci) and
-        `oat_k`. The autopilot flies the plan's true airspeed either way.
+        True impact pressure: ½ρV_t² (the paper's eq. 2, the default) or isentropic with
+        the ISA p_s and T at the altitude flown (pitotcal.core.airdata); compressible flights
+        also carry `ps_pa` (the static port: p_s + q_c − q_ci) and `oat_k`.
     gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts : float, float, bool
         Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s);
         fly Dryden's vertical gust too (`_plunge`; False: as before).
@@ -362,8 +360,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     speed_loop : maneuvers.autothrottle.SpeedLoop, optional
         Default: tuned at the plan's mid-range true airspeed.
     keep_history : bool
-        Also return the true time histories as numpy arrays in truth.history (not written
-        by `write_truth_json`).
+        Also keep the true time histories in truth.history (not written to the truth JSON).
     air_sensors : maneuvers.sim_options.AirSensors or dict, optional (issue 9; None: as before)
 
     Returns
@@ -392,6 +389,10 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps, w_up)
     tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)
     history = _history(plan, refs, wind, states, flight, qc, vel) if keep_history else None
-    loop = {"kp": speed_loop.kp, "ki": speed_loop.ki, "engine_lag_s": speed_loop.engine_lag_s,
+    return flight, _truth(plan, opts, seed, states, tracking, _loop_record(speed_loop), history)
+
+
+def _loop_record(speed_loop):
+    """The speed loop's description for the truth JSON."""
+    return {"kp": speed_loop.kp, "ki": speed_loop.ki, "engine_lag_s": speed_loop.engine_lag_s,
             "lift_to_drag": speed_loop.lift_to_drag, "trim_tas_mps": speed_loop.trim_tas_mps}
-    return flight, _truth(plan, opts, seed, states, tracking, loop, history)
