@@ -341,8 +341,9 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     """Read the inputs, write the HTML report (and the JSON / PDF when asked).
 
     `flight_options` are the reading identify used: start_s, end_s, oat_k (`read_flight`),
-    temp_recovery, rh_pct (`core.moist_air.with_static_air`); the re-fit takes the result's
-    model, air-data mode (`air_data`; "incompressible" when it records none) and GPS noise.
+    temp_recovery, rh_pct (`core.moist_air.with_static_air`); those not given (None) come from
+    the result's `reading`. The re-fit takes the result's model, air-data mode (`air_data`;
+    "incompressible" when it records none), GPS noise and stated GPS error (`gps_error`).
 
     Returns
     -------
@@ -358,14 +359,19 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
 
         from .identification import identify
 
-        opts = {k: v for k, v in (flight_options or {}).items() if v is not None}
+        # what identify recorded ("reading"), overridden by what the report was told
+        opts = {k: v for src in (result.get("reading") or {}, flight_options or {})
+                for k, v in src.items() if v is not None}
         flight = read_flight(flight_path, opts.pop("start_s", None), opts.pop("end_s", None),
                              oat_k=opts.pop("oat_k", None))
         # identify's temperature and humidity reading, then its air-data mode: the same fit
         flight = with_static_air(flight, **opts)
+        stated = result.get("gps_error") or {}
         ident = identify(flight, model=result.get("model", "inverse"),
                          air=result.get("air_data", "incompressible"),
-                         gps_noise_std_mps=result.get("gps_noise_std_mps"))
+                         gps_noise_std_mps=result.get("gps_noise_std_mps"),
+                         gps_error_sigma_mps=stated.get("sigma_mps"),
+                         gps_error_tau_s=stated.get("tau_s"))
         inputs.append(("Flight", flight_path))
     rows = ()
     if aircraft_path is not None:

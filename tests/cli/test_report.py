@@ -99,6 +99,33 @@ def test_incompressible_result_reproduced_with_its_air_data(tmp_path):
     assert "does not reproduce" not in (tmp_path / "r.html").read_text()
 
 
+def test_report_reads_the_flight_as_identify_recorded(tmp_path):
+    """identify's --temp-recovery, --rh-percent and window go into the JSON ("reading"), and
+    `report --flight` reads the flight the same way without being told again: the re-fit
+    reproduces the result (with a total temperature the recovery factor moves the fit)."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    flight, _ = synthetic_flight(seed=6, n=3000, k=(0.02, -15.0), cas_kt=(90.0, 150.0))
+    oat = np.full(flight.n, 288.15)
+    flight = replace(flight, tat_k=oat + 3.0, ps_pa=flight.rho_kgm3 * 287.05287 * oat)
+    csv, result = tmp_path / "flight.csv", tmp_path / "result.json"
+    write_flight_csv(flight, csv)
+    assert main(["identify", str(csv), "--temp-recovery", "0.8", "--rh-percent", "60",
+                 "--end-s", "55", "--no-budget", "--json", str(result)]) == 0
+    reading = json.loads(result.read_text())["reading"]
+    assert reading == {"start_s": None, "end_s": 55.0, "oat_k": None, "temp_recovery": 0.8,
+                       "rh_pct": 60.0}
+    html = tmp_path / "r.html"
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(html)]) == 0
+    assert "does not reproduce" not in html.read_text()
+    # told otherwise, the report reads it otherwise (and says the fit differs)
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(html),
+                 "--temp-recovery", "1.0"]) == 0
+    assert "does not reproduce" in html.read_text()
+
+
 def test_report_warnings_in_json_and_stderr(tmp_path, capsys):
     res, out_json = tmp_path / "res.json", tmp_path / "r.json"
     res.write_text(json.dumps(result_json(dv_kt=-1.0)))       # no dv_U_kt: no expanded U

@@ -157,7 +157,7 @@ def run(args):
     # issue 15: every file is written before anything is printed, so a reader that goes
     # away early (`| head`) never costs a file
     if args.json is not None:
-        _write_json(args.json, result, flight, source, budget, _gps_error(args))
+        _write_json(args.json, result, flight, source, budget, _gps_error(args), _reading(args))
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
     params, refused = None, None
@@ -279,7 +279,16 @@ def _gps_error(args):
             "gps_error_tau_s": args.gps_error_tau_s}
 
 
-def _write_json(path, result, flight, source, budget=None, gps_error=None):
+def _reading(args):
+    """JSON "reading": how the flight was read and its air made (`pitotcal report --flight`
+    reads it the same way unless told otherwise)."""
+    from pitotcal.cli.common import oat_k_from_c
+
+    return {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c),
+            "temp_recovery": args.temp_recovery, "rh_pct": args.rh_percent}
+
+
+def _write_json(path, result, flight, source, budget=None, gps_error=None, reading=None):
     """The result JSON, with every warning the reader gave in its "warnings"."""
     from pitotcal.estimation.budget_report import add_budget
     from pitotcal.io.jsonfile import json_ready, write_json
@@ -292,6 +301,8 @@ def _write_json(path, result, flight, source, budget=None, gps_error=None):
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
     out.update(_monitor_noise_model(result))
     out.update(_gps_error_record(gps_error))
+    if reading is not None:
+        out["reading"] = reading
     write_json(path, out)
 
 
