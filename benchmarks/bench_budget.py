@@ -14,16 +14,10 @@ import sys
 import time
 from pathlib import Path
 
+from timing import median_s
+
 ROOT = Path(__file__).resolve().parents[1]
 
-
-def _median_s(fun, repeats):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fun()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def main(argv=None):
@@ -43,8 +37,8 @@ def main(argv=None):
         flight, _ = synthetic_flight(seed=1, n=n, gps_rate_hz=5.0, gps_noise_mps=0.05,
                                      qc_noise_pa=0.5, turbulence_mps=0.3, vertical=True)
         result = identify(flight)                      # builds and caches the solver
-        t_id = _median_s(lambda f=flight: identify(f), args.repeats)
-        t_b = _median_s(lambda f=flight, r=result: uncertainty_budget(f, r, inputs),
+        t_id = median_s(lambda f=flight: identify(f), args.repeats)
+        t_b = median_s(lambda f=flight, r=result: uncertainty_budget(f, r, inputs),
                         args.repeats)
         print(f"| {n:,} | {t_id:.3f} | {t_b:.3f} | 14 | {t_b / t_id:.1f} |")
     _command(synthetic_flight, args.repeats)

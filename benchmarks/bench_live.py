@@ -18,6 +18,8 @@ import time
 from pathlib import Path
 from types import SimpleNamespace
 
+from timing import median_s
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -47,14 +49,6 @@ def _buffer(flight):
                                 temperature=(temp_k[i] - 273.15) * 100))
     return buf
 
-
-def _median(fun, repeats):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        fun()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def _update_times(flight, grown, buf, repeats, warm):
@@ -89,8 +83,8 @@ def main():
     flight = _flight(args.samples)
     buf = _buffer(flight)
     grown = flight.window(None, flight.time_s[-1] - 1.0)
-    offline = _median(lambda: identify(flight), args.repeats)
-    to_flight = _median(buf.flight, args.repeats)
+    offline = median_s(lambda: identify(flight), args.repeats)
+    to_flight = median_s(buf.flight, args.repeats)
     cold, cold_parts, _ = _update_times(flight, grown, buf, args.repeats, warm=False)
     warm, warm_parts, last = _update_times(flight, grown, buf, args.repeats, warm=True)
     cal = Calibration.from_result(identify(flight))

@@ -8,21 +8,13 @@ existing calibration figure, the baseline the report figures are compared with);
 """
 
 import argparse
-import statistics
 import sys
-import time
 from pathlib import Path
+
+from timing import median_s
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-
-def _median(fun, repeats):
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fun()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
 
 
 def main():
@@ -51,7 +43,7 @@ def main():
     ]
     base = None
     print(f"| step (N = {flight.n}) | median s | / baseline |\n|---|---:|---:|")
-    results = [(name, _median(fun, args.repeats)) for name, fun in rows]
+    results = [(name, median_s(fun, args.repeats)) for name, fun in rows]
     base = dict(results)["baseline: result.plot() to PNG"]
     for name, sec in results:
         print(f"| {name} | {sec:.3f} | {sec / base:.2f} |")
