@@ -246,10 +246,8 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         node in the given wind.
     altitude_m : float
         Constant plan altitude (ISA density there gives TAS from CAS).
-    duration_s : float
-        Maneuver length, s.
-    bank_max_deg : float
-        Bank limit, degrees.
+    duration_s, bank_max_deg : float
+        Maneuver length, s; bank limit, degrees.
     wind_speed_mps, wind_from_deg : float
         Expected mean wind: speed, and the direction it blows FROM (deg true, in [0, 360)).
     roll_rate_max_dps, accel_max_mps2 : float, optional
@@ -262,14 +260,11 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         Turn direction; "both" alternates from one coverage group to the next.
     dt_s : float
         Node spacing of the plan, s.
-    margin_m : float
-        Radius margin against overshoot between nodes.
-    heading_margin_deg : float
-        Turn beyond 360 deg demanded in each third of the q range.
-    max_iter : int
-        IPOPT's iteration limit.
-    ipopt_options : dict, optional
-        Passed to IPOPT (on top of `max_iter`).
+    margin_m, heading_margin_deg : float
+        Radius margin against overshoot between nodes; turn beyond 360 deg demanded in each
+        third of the q range.
+    max_iter, ipopt_options : int, dict (optional)
+        IPOPT's iteration limit, and options passed to it on top of that.
     design, design_options : {"paper", "optimal"}, dict or maneuvers.design_request.DesignOptions
         "optimal": the speed schedule designed for information (maneuvers.design) replaces
         `profile`'s (the plan's profile is then "optimal"), with these options.
