@@ -90,15 +90,20 @@ class LiveIdentifier:
     """
 
     def __init__(self, model="inverse", air="compressible", gps_error=None):
-        from .identification import _gps_error
         from .oe import OutputErrorProblem
 
         self.model, self.air = model, air
         self.gps_error = dict(gps_error or {})
-        self._stated = _gps_error(self.gps_error.get("gps_error_sigma_mps"),
-                                  self.gps_error.get("gps_error_tau_s"))
+        self._stated(None)          # a bad statement is refused before any stream is read
         self.problem = None if model == "auto" else OutputErrorProblem(model)
         self.start = None           # the last converged internal parameters
+
+    def _stated(self, flight):
+        """The stated GPS error as `identify` checks it against `flight` (None: no record yet)."""
+        from .identification import _gps_error
+
+        return _gps_error(self.gps_error.get("gps_error_sigma_mps"),
+                          self.gps_error.get("gps_error_tau_s"), flight)
 
     def update(self, flight, warm=True):
         """The fit of `flight`; `warm=False` starts IPOPT from the linear least-squares start
@@ -113,7 +118,7 @@ class LiveIdentifier:
         flight, _ = robust.gate_flight(flight)
         identification._check_track(flight)
         result = self.problem.solve(flight, start=self.start if warm else None,
-                                    air_data=air_data, gps_error=self._stated)
+                                    air_data=air_data, gps_error=self._stated(flight))
         if result.success:
             self.start = np.asarray(result.internal_params, float)
         return result
