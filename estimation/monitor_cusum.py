@@ -4,8 +4,9 @@ q_ci "liveness", with thresholds designed for a stated false-alarm rate, and the
 
 Statistics, each a one-sided CUSUM S = max(0, S + x − κ), alarm at S > h (Page 1954):
 
-* ``low`` / ``high``: x = ∓z, z = w/σ_w the block's innovation, w = e_k − a e_{k−1}, e the
-  relative residual (`monitor_model`); whitening turns the turbulence's colored residual into
+* ``low`` / ``high``: x = ∓z, z = w/σ_w the block's innovation, w = e_k − Σ φ_i e_{k−i}, e the
+  residual in the noise model's unit (`monitor_model`: airspeed, m/s; relative for older
+  calibrations); whitening turns the turbulence's colored residual into
   near-white innovations, so a jump shows at once in one innovation and a ramp as a growing
   mean (slow faults: a small κ).
 * ``still`` / ``erratic``: x = ∓y, y = (log band variance − μ)/σ the block's liveness: a frozen
@@ -15,8 +16,11 @@ Statistics, each a one-sided CUSUM S = max(0, S + x − κ), alarm at S > h (Pag
 ``low`` and ``high`` also fire on one innovation beyond ±c (a Shewhart limit beside the CUSUM,
 Lucas 1982): a jump (leak, blocked port) is flagged in the block it happens in.
 
-Design (`design`): the false-alarm budget (per flight hour) is split evenly over the four
-CUSUMs and the two Shewhart limits; each CUSUM gets the threshold whose in-control average run
+``ramp``: the Shiryaev–Roberts test for a ramp of e (`monitor_ramp`).
+
+Design (`design`): RAMP_SHARE of the false-alarm budget (per flight hour) goes to the ramp
+test (threshold log of its ARL₀, exact), the rest evenly to the four CUSUMs and the two
+Shewhart limits; each CUSUM gets the threshold whose in-control average run
 length (ARL₀) by Siegmund's approximation for N(0,1) increments,
 ARL₀ ≈ (e^{2κ(h+1.166)} − 2κ(h+1.166) − 1)/(2κ²), is the inverse of its share, and c is the
 normal quantile of one block's share. The monitor study measures the rate actually reached.
@@ -29,7 +33,7 @@ import numpy as np
 
 from pitotcal.core.checks import number, positive
 
-from .monitor_glr import RampGLR, glr_threshold
+from .monitor_ramp import RampTest, ramp_threshold
 
 __all__ = [
     "STATISTICS",
@@ -39,6 +43,7 @@ __all__ = [
     "ar_coefficients",
     "cusum_threshold",
     "design",
+    "in_velocity",
     "siegmund_arl",
     "variance_ratio",
 ]
@@ -48,6 +53,10 @@ STATISTICS = (*CUSUMS, "ramp")
 _CLIP_SIGMA = 3.0          # innovations beyond this do not move the scale trackers (robust)
 _PRIOR_BLOCKS = 10.0       # weight of the calibration's noise model, in blocks of evidence
 _MAX_RHO_Y = 0.9           # the liveness's tracked lag-one correlation is capped here
+# Share of the false-alarm budget given to the ramp test (slow faults are the hard ones: a jump
+# is seen at once by several statistics); the rest is split evenly over the CUSUMs and the two
+# Shewhart limits.
+RAMP_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -69,7 +78,14 @@ class MonitorOptions:
         fluctuation relative to q_ci changes with the airspeed (a frozen pitot is seen in a
         second or two, well inside it).
     wind_tau_s, warmup_wind_tau_s : float
-        Time constant of the wind tracker after / during the warm-up, s.
+        Time constant of the wind tracker after / during the warm-up, s. 60 s follows a wind
+        drifting 0.35 m/s per minute (the monitor study's) closely enough that the ramp test
+        does not take it for a fault, and a circling aircraft's heading keeps a drift of the
+        airspeed itself from being learned as wind (measured: 2 kt/min icing found as soon as
+        with 180 s).
+    drift_kt_per_min : float
+        The drift of the indicated airspeed the ramp test is tuned to (its slope prior's
+        standard deviation), kt/min.
     """
 
     false_alarms_per_hour: float = 0.02
@@ -78,20 +94,30 @@ class MonitorOptions:
     warmup_s: float = 30.0
     variance_tau_s: float = 120.0
     band_tau_s: float = 20.0
-    wind_tau_s: float = 180.0
+    wind_tau_s: float = 60.0
     warmup_wind_tau_s: float = 10.0
+    drift_kt_per_min: float = 2.0
 
     def checked(self):
         number("false_alarms_per_hour", self.false_alarms_per_hour, 0.0, lo_open=True)
         for name in ("kappa", "kappa_band", "variance_tau_s", "band_tau_s", "wind_tau_s",
-                     "warmup_wind_tau_s"):
+                     "warmup_wind_tau_s", "drift_kt_per_min"):
             positive(name, getattr(self, name))
         number("warmup_s", self.warmup_s, 0.0)
         return self
 
 
+def in_velocity(noise):
+    """Whether the noise model describes the residual in airspeed (m/s, ``"ar_mps"``) rather
+    than relative to q_ci (calibrations written before it was added)."""
+    return "innovation_std_mps" in noise
+
+
 def ar_coefficients(noise):
-    """The noise model's AR coefficients φ_1..φ_p (``"ar"``; older calibrations: [``"ar1"``])."""
+    """The AR coefficients φ_1..φ_p of the residual the monitor tests: ``"ar_mps"`` (airspeed),
+    else ``"ar"`` (relative; older calibrations: [``"ar1"``])."""
+    if in_velocity(noise):
+        return np.atleast_1d(np.asarray(noise["ar_mps"], float))
     return np.atleast_1d(np.asarray(noise.get("ar") or [noise["ar1"]], float))
 
 
@@ -128,15 +154,16 @@ def design(opts, block_s):
     arl_hours_each, false_alarms_per_hour}."""
     from scipy.stats import norm
 
-    share = opts.false_alarms_per_hour / (len(STATISTICS) + 2)
+    share = opts.false_alarms_per_hour * (1.0 - RAMP_SHARE) / (len(CUSUMS) + 2)
     arl_blocks = 3600.0 / block_s / share
     kappas = {"low": opts.kappa, "high": opts.kappa, "still": opts.kappa_band,
               "erratic": opts.kappa_band}
     h = {s: cusum_threshold(arl_blocks, k) for s, k in kappas.items()}
-    h["ramp"] = glr_threshold(1.0 / arl_blocks)
+    h["ramp"] = ramp_threshold(3600.0 / block_s / (opts.false_alarms_per_hour * RAMP_SHARE))
     return {"h": h,
             "kappa": kappas, "jump_sigma": float(norm.isf(1.0 / arl_blocks)),
             "arl_hours_each": 1.0 / share,
+            "arl_hours_ramp": 1.0 / (opts.false_alarms_per_hour * RAMP_SHARE),
             "false_alarms_per_hour": opts.false_alarms_per_hour, "block_s": block_s}
 
 
@@ -182,7 +209,9 @@ class SequentialTest:
     def __init__(self, noise, plan, opts):
         self.plan, self.opts, self.block_s = plan, opts, plan["block_s"]
         self.phi = ar_coefficients(noise)
-        self.sw2 = float(noise["innovation_rel_std"]) ** 2
+        self.velocity = in_velocity(noise)
+        self.sw2 = float(noise["innovation_std_mps" if self.velocity
+                               else "innovation_rel_std"]) ** 2
         self.e_var_ratio = variance_ratio(self.phi)
         self.mu_l = noise.get("band_log_mean")
         sl = noise.get("band_log_std")
@@ -191,7 +220,7 @@ class SequentialTest:
         self.n_seen_w = _PRIOR_BLOCKS
         self.rho_y, self.y_prev = 0.0, None
         self.e_past = deque(maxlen=self.phi.size)     # e_{k-1}, e_{k-2}, ...
-        self.ramp = RampGLR(self.phi, self.block_s)
+        self.ramp = RampTest(self.phi, self.block_s)
         self.values = dict.fromkeys(STATISTICS, 0.0)
         self.zero_s = dict.fromkeys(STATISTICS, None)
         self.open = set()
@@ -200,7 +229,9 @@ class SequentialTest:
         """No statistic (of `stats`) above half its threshold: the data may teach the trackers."""
         return all(self.values[s] < 0.5 * self.plan["h"][s] for s in stats)
 
-    def step(self, t_s, e, log_band, learning):
+    def step(self, t_s, e, log_band, learning, drift=0.0):
+        """One block: `e` its residual (in the noise model's unit), `drift` the ramp test's
+        slope prior (standard deviation, same unit per block)."""
         past = self.e_past
         z = 0.0 if len(past) < past.maxlen else \
             (e - float(self.phi @ np.fromiter(past, float))) / np.sqrt(self.sw2)
@@ -220,7 +251,7 @@ class SequentialTest:
             self._learn_band(y)
         self.y_prev = y
         x = {"low": -z, "high": z, "still": -y_w, "erratic": y}
-        fired = self._ramp(t_s, z, learning)
+        fired = self._ramp(t_s, z, learning, drift * drift / self.sw2)
         for s in CUSUMS:
             h, k = self.plan["h"][s], self.plan["kappa"][s]
             v = max(0.0, self.values[s] + x[s] - k)
@@ -238,9 +269,9 @@ class SequentialTest:
                 self.open.discard(s)
         return tuple(fired), z, y
 
-    def _ramp(self, t_s, z, learning):
-        """The ramp GLR: fires at G > h, ends below h/2; its onset is the best τ."""
-        g, m, _ = self.ramp.update(z)
+    def _ramp(self, t_s, z, learning, v):
+        """The ramp test: fires at log R > h, ends below h/2; its onset the likeliest τ."""
+        g, m, _ = self.ramp.update(z, v)
         h = self.plan["h"]["ramp"]
         self.values["ramp"] = min(g, 0.5 * h) if learning else g
         if learning:

@@ -7,9 +7,11 @@ V_t², p_s and T_s (`core.airdata`, compressible) as the calibration's ``"air_da
 incompressible) — then what the pitot reads through the identified pressure error.
 
 The noise model (`noise_model`) describes the calibration's output residuals on the monitor's
-block grid (BLOCK_S): the relative residual e = (q_ci − predicted)/predicted of each block is
-AR(1) (turbulence is colored: correlation times of seconds), e_k = a e_{k−1} + w_k, and the
-log of the in-block (detrended) variance of the measured q_ci, the signal's high-frequency
+block grid (BLOCK_S): the relative residual e = (q_ci − predicted)/predicted of each block, and
+the same in airspeed, ΔV_i = e V_i/2 (the unit the monitor tests in: turbulence moves the
+airspeed by about the same m/s at every speed, so its fraction of q_ci changes along a speed
+sweep, and icing lowers V_i by kt/min), are autoregressive (turbulence is colored: correlation
+times of seconds), e_k = Σ φ_i e_{k−i} + w_k, and the log of the in-block (detrended) variance of the measured q_ci, the signal's high-frequency
 "liveness", is roughly normal. `pitotcal identify --json` writes it as ``"noise_model"``.
 """
 
@@ -20,7 +22,14 @@ import numpy as np
 from pitotcal.core.checks import choice
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model, qci_from_qc_pa
-from pitotcal.core.units import R_AIR_JKGK, RHO0_KGM3, isa_pressure_pa, kt_to_mps, wind_vector_mps
+from pitotcal.core.units import (
+    R_AIR_JKGK,
+    RHO0_KGM3,
+    incompressible_cas_mps,
+    isa_pressure_pa,
+    kt_to_mps,
+    wind_vector_mps,
+)
 
 __all__ = ["BLOCK_S", "Blocks", "Calibration", "block_stats", "noise_model", "predict_qci_pa"]
 
@@ -173,9 +182,10 @@ def noise_model(result, block_s=BLOCK_S):
     dict
         block_s; rel_std (std of the blocks' relative residual e); ar1 (a, lag-one
         correlation of e); ar (φ_1..φ_p, least-squares AR(AR_ORDER) coefficients of e);
-        innovation_rel_std (robust std of w = e_k − Σ φ_i e_{k−i}); band_log_mean
-        and band_log_std (median and robust std of log of the blocks' relative band variance);
-        n_blocks.
+        innovation_rel_std (robust std of w = e_k − Σ φ_i e_{k−i}); std_mps, ar_mps and
+        innovation_std_mps (the same of the residual in airspeed, ΔV_i = e V_i / 2, m/s: the
+        unit the monitor tests in); band_log_mean and band_log_std (median and robust std of
+        log of the blocks' relative band variance); n_blocks.
     """
     qci = np.asarray(result.qci_pa, float)
     pred = qci - np.asarray(result.residuals_pa, float)
@@ -185,15 +195,27 @@ def noise_model(result, block_s=BLOCK_S):
     if e.size < 10:
         raise PitotcalError(f"a noise model needs >= 10 blocks of {block_s:g} s, got {e.size}")
     e = e - e.mean()
-    a = float(np.clip(np.corrcoef(e[:-1], e[1:])[0, 1], 0.0, 0.98))
-    phi, w = _ar_fit(e, AR_ORDER)
-    if phi is None:                    # not stationary: the lag-one AR(1)
-        phi, w = [a], e[1:] - a * e[:-1]
+    a, phi, w = _ar_model(e)
+    # the same in airspeed, ΔV_i = e V_i / 2 (V_i of the predicted q_ci): the monitor's unit
+    dv = e * 0.5 * incompressible_cas_mps(pred_b)
+    _, phi_v, w_v = _ar_model(dv - dv.mean())
     log_band = np.log(blocks.band_rel_var)
     return {"block_s": block_s, "rel_std": float(np.std(e)), "ar1": a, "ar": list(phi),
             "innovation_rel_std": _robust_std(w),
+            "std_mps": float(np.std(dv)), "ar_mps": list(phi_v),
+            "innovation_std_mps": _robust_std(w_v),
             "band_log_mean": float(np.median(log_band)), "band_log_std": _robust_std(log_band),
             "n_blocks": int(e.size)}
+
+
+def _ar_model(e):
+    """(lag-one correlation, AR(AR_ORDER) coefficients, innovations) of `e`; AR(1) at the
+    lag-one correlation when the AR(AR_ORDER) fit is not stationary."""
+    a = float(np.clip(np.corrcoef(e[:-1], e[1:])[0, 1], 0.0, 0.98))
+    phi, w = _ar_fit(e, AR_ORDER)
+    if phi is None:
+        phi, w = [a], e[1:] - a * e[:-1]
+    return a, phi, w
 
 
 def _ar_fit(e, p):

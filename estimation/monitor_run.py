@@ -8,6 +8,8 @@ nothing is suspect — one step of the wind tracker (fast during the warm-up, th
 
 import numpy as np
 
+from pitotcal.core.units import incompressible_cas_mps, kt_to_mps
+
 from .monitor_cusum import STATISTICS, SequentialTest, WindTracker, design
 from .monitor_model import block_stats, predict_qci_pa
 
@@ -27,6 +29,7 @@ class BlockLoop:
         self.plan = design(opts, self.block_s)
         self.test = SequentialTest(cal.noise, self.plan, opts)
         self.wind = WindTracker((cal.wind_n_mps, cal.wind_e_mps))
+        self.drift_mps = kt_to_mps(opts.drift_kt_per_min) / 60.0 * self.block_s
         self.trace = {k: [] for k in _TRACE}
         self.alarms, self.active, self.settled = [], {}, False
         self.t0 = None
@@ -70,8 +73,14 @@ class BlockLoop:
         learning = t - self.t0 < opts.warmup_s
         pred, grad = _predict_block(self.cal, inputs, j, wind.wind)
         e = (blocks.qci_pa[j] - pred) / pred
-        fired, z, y = test.step(t, e, np.log(max(blocks.band_rel_var[j], 1e-30)), learning)
-        r_var = pred * pred * test.sw2 * test.e_var_ratio
+        # the tests run on the residual in the noise model's unit: airspeed (q_ci ∝ V_i², so
+        # ΔV_i = e V_i / 2; turbulence and icing act on the speed, not on q_ci's fraction) or,
+        # for older calibrations, relative
+        per_e = 0.5 * float(incompressible_cas_mps(pred)) if test.velocity else 1.0
+        drift = self.drift_mps * (1.0 if test.velocity else 2.0 / float(incompressible_cas_mps(pred)))
+        fired, z, y = test.step(t, e * per_e, np.log(max(blocks.band_rel_var[j], 1e-30)),
+                                learning, drift)
+        r_var = (pred / per_e) ** 2 * test.sw2 * test.e_var_ratio
         if not learning and not self.settled:
             wind.settle(grad, r_var, self.block_s, opts.wind_tau_s)
             self.settled = True
@@ -100,7 +109,8 @@ class BlockLoop:
         alarms = _merge(sorted([dict(a) for a in self.alarms] + open_now,
                                key=lambda a: a["start_s"]))
         trace = {k: np.asarray(v, float) for k, v in self.trace.items()}
-        adapted = {"innovation_rel_std": float(np.sqrt(self.test.sw2)),
+        scale = "innovation_std_mps" if self.test.velocity else "innovation_rel_std"
+        adapted = {scale: float(np.sqrt(self.test.sw2)),
                    "band_log_mean": self.test.mu_l,
                    "band_log_std": float(np.sqrt(self.test.sl2 or 0.0)),
                    "wind_n_mps": float(self.wind.wind[0]),

@@ -16,6 +16,9 @@ def test_monitor_study_quick(tmp_path):
     assert det["leak:0.1"]["detected"] == 1.0 and det["leak:0.1"]["max_s"] <= 10.0
     assert det["blocked:0"]["kind_right"] == 1.0 and det["leak:0.1"]["kind_right"] == 1.0
     assert summary["targets"]["frozen"]["met"] and summary["targets"]["leak_10pct"]["met"]
+    # the oracle, told the leak, finds it in the first block after the onset, like the monitor
+    assert det["leak:0.1"]["oracle"]["max_s"] <= 1.0
+    assert "oracle" not in det["blocked:0"]
     assert (tmp_path / "monitor.png").stat().st_size > 10_000
 
 

@@ -38,6 +38,9 @@ def add_parser(subparsers):
     t.add_argument("--warmup-s", type=float, default=30.0, metavar="S",
                    help="seconds at the start to learn turbulence and wind, without alarms "
                         "(default %(default)s)")
+    t.add_argument("--drift-kt-per-min", type=float, default=2.0, metavar="RATE",
+                   help="indicated-airspeed drift the ramp test is tuned to, kt/min "
+                        "(default %(default)s)")
     p.set_defaults(run=run)
 
 
@@ -100,7 +103,8 @@ def run(args):
         check_figure_format("--plot", args.plot)
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
-                          warmup_s=args.warmup_s).checked()
+                          warmup_s=args.warmup_s,
+                          drift_kt_per_min=args.drift_kt_per_min).checked()
     if is_connection(args.source):
         result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k_from_c(args.oat_c),
                                      idle_timeout_s=positive("idle_s", args.idle_s),
