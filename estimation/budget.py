@@ -45,7 +45,13 @@ import numpy as np
 from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.moist_air import moist_density_kgm3
-from pitotcal.core.units import G0_MPS2, R_AIR_JKGK, isa_temperature_k, wind_vector_mps
+from pitotcal.core.units import (
+    G0_MPS2,
+    ISA_T0_K,
+    R_AIR_JKGK,
+    isa_temperature_k,
+    wind_vector_mps,
+)
 
 __all__ = ["COVERAGE_K", "SOURCES", "Budget", "BudgetInputs", "uncertainty_budget"]
 
@@ -220,7 +226,7 @@ def static_temperature_of(flight):
         return flight.ps_pa / (R_AIR_JKGK * flight.rho_kgm3)
     if flight.alt_m is not None and np.any(np.isfinite(flight.alt_m)):
         return np.full(flight.n, float(isa_temperature_k(np.nanmean(flight.alt_m))))
-    return np.full(flight.n, 288.15)
+    return np.full(flight.n, ISA_T0_K)
 
 
 def oat_error(flight, result, dt_k):
