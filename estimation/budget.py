@@ -166,9 +166,10 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     -----
     Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
     vertical channel): at most 14, each reusing `identify`'s cached solver
-    (benchmarks/bench_budget.py measures the cost).
+    (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
+    identify's estimate without the bounds and consistency checks the budget does not use.
     """
-    from .identification import identify
+    from .identification import estimate
 
     inputs = (inputs or BudgetInputs()).checked()
     rows = result.correction_table()
@@ -188,7 +189,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
         """u at each speed: the RMS of the re-solves' changes at +u and -u."""
         dv = []
         for sign in (1.0, -1.0):
-            res = identify(perturb(sign), **kwargs)
+            res = estimate(perturb(sign), **kwargs)
             if not res.success:
                 notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
                              f"({res.message})")
