@@ -45,7 +45,13 @@ import numpy as np
 from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.moist_air import moist_density_kgm3
-from pitotcal.core.units import G0_MPS2, R_AIR_JKGK, isa_temperature_k, wind_vector_mps
+from pitotcal.core.units import (
+    G0_MPS2,
+    ISA_T0_K,
+    R_AIR_JKGK,
+    isa_temperature_k,
+    wind_vector_mps,
+)
 
 __all__ = ["COVERAGE_K", "SOURCES", "Budget", "BudgetInputs", "uncertainty_budget"]
 
@@ -160,9 +166,10 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     -----
     Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
     vertical channel): at most 14, each reusing `identify`'s cached solver
-    (benchmarks/bench_budget.py measures the cost).
+    (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
+    identify's estimate without the bounds and consistency checks the budget does not use.
     """
-    from .identification import identify
+    from .identification import estimate
 
     inputs = (inputs or BudgetInputs()).checked()
     rows = result.correction_table()
@@ -182,7 +189,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
         """u at each speed: the RMS of the re-solves' changes at +u and -u."""
         dv = []
         for sign in (1.0, -1.0):
-            res = identify(perturb(sign), **kwargs)
+            res = estimate(perturb(sign), **kwargs)
             if not res.success:
                 notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
                              f"({res.message})")
@@ -220,7 +227,7 @@ def static_temperature_of(flight):
         return flight.ps_pa / (R_AIR_JKGK * flight.rho_kgm3)
     if flight.alt_m is not None and np.any(np.isfinite(flight.alt_m)):
         return np.full(flight.n, float(isa_temperature_k(np.nanmean(flight.alt_m))))
-    return np.full(flight.n, 288.15)
+    return np.full(flight.n, ISA_T0_K)
 
 
 def oat_error(flight, result, dt_k):

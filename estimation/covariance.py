@@ -174,18 +174,30 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     # The noise model is fitted to one record: its long-run variance has few degrees of
     # freedom (T / (4 tau) for one exponential, `noise_model.DOF_TAUS`): Student-t widening.
     cov = cov * student_t_widening(dof) ** 2
-    return ColoredCovariance(cov, lag, window, a, _few_stretches(n, window, a, lag), dof)
+    return ColoredCovariance(cov, lag, window, a, _few_stretches(residuals), dof)
 
 
-def _few_stretches(n, window, a, lag):
-    """The warning when the record holds fewer than MIN_STRETCHES correlation times, else
-    None; the correlation time is the fitted decay's, or half the lag window."""
-    tau = (-1.0 / np.log(a) if window in ("exponential", "multiscale") and 0.0 < a < 1.0
-           else lag / 2.0)
-    stretches = n / max(2.0 * tau, 1.0)
+def _few_stretches(residuals):
+    """The warning when the record holds fewer than MIN_STRETCHES independent stretches, else
+    None.
+
+    A stretch is 2 tau = 1 + 2 sum_k rho_k samples, the residuals' autocorrelation summed up
+    to its first zero (their integral time scale), measured on the residuals themselves: the
+    fitted model's long-run-weighted correlation time is no measure of it, as its slowest term
+    lands near the longest time its grid allows (a fifth of the record) on about half of the
+    flights in plain turbulence (docs/measured.md, "The few-stretches warning").
+    """
+    v = residuals - residuals.mean()
+    acov = residual_acf(v, v.size // 4)
+    if acov.size < 2 or not acov[0] > 0.0:
+        return None
+    rho = acov[1:] / acov[0]
+    first_zero = np.flatnonzero(rho <= 0.0)
+    two_tau = 1.0 + 2.0 * float(rho[:first_zero[0] if first_zero.size else rho.size].sum())
+    stretches = v.size / two_tau
     if stretches >= MIN_STRETCHES:
         return None
-    return (f"residuals correlated over ~{2 * tau:.0f} samples: only ~{stretches:.0f} "
+    return (f"residuals correlated over ~{two_tau:.0f} samples: only ~{stretches:.0f} "
             "independent stretches of data, so the corrected bounds are themselves "
             f"uncertain by ~{100 / np.sqrt(max(stretches, 1.0)):.0f}%; fly longer")
 

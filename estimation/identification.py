@@ -93,12 +93,30 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
+    return _identify(flight, model, air, gps_noise_std_mps, ipopt_options,
+                     (gps_error_sigma_mps, gps_error_tau_s), bounds=True)
+
+
+def estimate(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
+             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
+    """`identify`'s estimate alone, for re-solves that use only it (`estimation.budget`).
+
+    The same checks, gates, outlier trimming and fit, so the same parameters; without the
+    colored-residual covariance and the consistency checks: `covariance` is the plain one and
+    `consistency` is empty, so its bounds are not the result's.
+    """
+    return _identify(flight, model, air, gps_noise_std_mps, ipopt_options,
+                     (gps_error_sigma_mps, gps_error_tau_s), bounds=False)
+
+
+def _identify(flight, model, air, gps_noise_std_mps, ipopt_options, gps_error, *, bounds):
+    """`identify` (`bounds` True) or `estimate` (False)."""
     checks.choice("model", model, (*MODELS, "auto"))
     if gps_noise_std_mps is not None:
         gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0)
     ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
     checks.choice("air", air, AIR_DATA_MODES)
-    gps_error = _gps_error(gps_error_sigma_mps, gps_error_tau_s, flight)
+    gps_error = _gps_error(*gps_error, flight)
     air_data, air_note = _air_data(flight, air)
     _check_flight(flight, air_data)
     flight, gate_note = robust.gate_flight(flight)
@@ -106,17 +124,20 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
     _check_track(flight)
     result, trim_note = _fit_trimmed(flight, functools.partial(
         _identify_any, model=model, gps_noise_std_mps=gps_noise_std_mps,
-        ipopt_options=ipopt_options, air_data=air_data, gps_error=gps_error), air_data)
+        ipopt_options=ipopt_options, air_data=air_data, gps_error=gps_error, colored=bounds),
+        air_data, check=bounds)
     # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
     warn = tuple(dict.fromkeys(tuple(flight.warnings) + gate_note + trim_note
                                + tuple(result.warnings) + air_note))
     return dataclasses.replace(result, warnings=warn)
 
 
-def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data, gps_error):
-    if model == "auto":
+def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data, gps_error,
+                  colored=True):
+    if model == "auto":        # the criterion needs the colored covariance: always computed
         return _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data, gps_error)
-    return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error)
+    return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error,
+                         colored)
 
 
 def _gps_error(sigma_mps, tau_s, flight=None):
@@ -140,12 +161,13 @@ def _gps_error(sigma_mps, tau_s, flight=None):
     return sigma, tau
 
 
-def _fit_trimmed(flight, fit, air_data):
+def _fit_trimmed(flight, fit, air_data, check=True):
     """(result, warnings): the fit, refitted without the samples `robust.outliers` finds.
 
     Up to `_TRIM_ROUNDS` rounds; each refit's residuals are judged again on the kept samples.
     More than `robust.MAX_TRIM_FRACTION` trimmed is refused: the noise is not the Gaussian
-    the bounds assume, and no trimming threshold makes them honest.
+    the bounds assume, and no trimming threshold makes them honest. `check` False skips the
+    consistency checks (`estimate`).
     """
     keep = np.ones(flight.n, dtype=bool)
     result = fit(flight)
@@ -162,9 +184,9 @@ def _fit_trimmed(flight, fit, air_data):
                 "look for a leak, a blockage or a bad channel")
         result = fit(flight.select(keep))
     kept = flight.select(keep) if not keep.all() else flight
-    step_note, check = consistency.check(kept, result, air_data) if result.success \
+    step_note, found = consistency.check(kept, result, air_data) if result.success and check \
         else ((), {})
-    result = dataclasses.replace(result, consistency=check)
+    result = dataclasses.replace(result, consistency=found)
     if keep.all():
         return result, step_note
     return result, (
@@ -219,7 +241,8 @@ def _candidate(result, n_eff):
             "params": dict(zip(result.param_names, map(float, result.params)))}
 
 
-def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error=None):
+def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error=None,
+                  colored=True):
     m = get_model(model)
     if len(m.params) > 1:
         _check_qci_span(flight, m)
@@ -227,7 +250,7 @@ def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps
     if key not in _PROBLEMS:
         _PROBLEMS[key] = OutputErrorProblem(model, ipopt_options=ipopt_options)
     result = _PROBLEMS[key].solve(flight, gps_noise_std_mps=gps_noise_std_mps,
-                                  air_data=air_data, gps_error=gps_error)
+                                  air_data=air_data, gps_error=gps_error, colored=colored)
     if result.success:
         _check_information(result)
     return result

@@ -196,7 +196,7 @@ class OutputErrorProblem:
         return self._built[key]
 
     def solve(self, flight, *, gps_noise_std_mps=None, start=None, air_data="incompressible",
-              gps_error=None):
+              gps_error=None, colored=True):
         """Identify the coefficients and the wind from `flight`.
 
         Parameters
@@ -215,6 +215,9 @@ class OutputErrorProblem:
         gps_error : (float, float), optional
             (sigma_mps, tau_s) of a stated Gauss-Markov GPS velocity error: a known term of
             the colored-residual covariance (`covariance.colored_covariance`).
+        colored : bool
+            False: no colored-residual covariance (`covariance` is the plain one), for
+            re-solves that use only the estimate (`estimation.budget`).
 
         Returns
         -------
@@ -231,7 +234,8 @@ class OutputErrorProblem:
         timing["solve"] = time.perf_counter() - t0
 
         t0 = time.perf_counter()
-        fit = _refine(self.model, built, x_opt, p_val, weight, ch, flight.time_s, gps_error)
+        fit = _refine(self.model, built, x_opt, p_val, weight, ch, flight.time_s, gps_error,
+                      colored)
         timing["covariance"] = time.perf_counter() - t0
         return _result(self.model, flight, ch, fit, stats, timing, air_data)
 
@@ -254,7 +258,7 @@ def _minimise(model, built, ch, theta0):
     return np.asarray(sol["x"]).ravel(), p_val, values["weight"], built.solver.stats()
 
 
-def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None):
+def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None, colored=True):
     """Instrumental-variable refinement and both covariances at the output-error optimum."""
     warn = []
     scales = theta_scales(model)
@@ -269,18 +273,14 @@ def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None):
         theta, jac = theta_iv, jac_iv
     residuals = residual(model, theta, *ch.args)
     cov_plain = plain_covariance(jac, residuals, information=info)
-    known = None
-    if gps_error is not None:      # tau in samples of this record's median interval
-        known = (gps_error[0], gps_error[1] / max(float(np.median(np.diff(time_s))), 1e-9))
-    if instruments is None:
-        colored = colored_covariance(jac, residuals, information=info, velocity=jac[:, -2:],
-                                     known_velocity=known)
-    else:
-        colored = colored_covariance(jac, residuals, information=instruments.T @ jac,
-                                     instruments=instruments, velocity=jac[:, -2:],
-                                     known_velocity=known)
-    warn += [w for w in (colored.warning, _gap_warning(time_s)) if w]
-    return _Fit(theta, residuals, cov_plain, colored, tuple(warn))
+    known = None if gps_error is None else (    # tau in samples of the median interval
+        gps_error[0], gps_error[1] / max(float(np.median(np.diff(time_s))), 1e-9))
+    cov = ColoredCovariance(cov_plain, 0, "none (not computed)", 0.0) if not colored else \
+        colored_covariance(jac, residuals, velocity=jac[:, -2:], known_velocity=known,
+                           information=info if instruments is None else instruments.T @ jac,
+                           instruments=instruments)    # not colored: the estimate alone
+    warn += [w for w in (cov.warning, _gap_warning(time_s)) if w]
+    return _Fit(theta, residuals, cov_plain, cov, tuple(warn))
 
 
 def _result(model, flight, ch, fit, stats, timing, air_data="incompressible"):

@@ -16,6 +16,7 @@ from pitotcal.core import units
     (units.isa_pressure_pa, 0.0, 101325.0),
     (units.isa_pressure_pa, 1000.0, 89874.6),       # ICAO standard atmosphere table
     (units.isa_density_kgm3, 1000.0, 1.11164),
+    (units.isa_altitude_m, 89874.6, 1000.0),
     (units.incompressible_qc_pa, 50.0, 1531.25),          # rho0 / 2 * 50^2
     (units.incompressible_cas_mps, 1531.25, 50.0),
     (units.incompressible_cas_mps, -1531.25, -50.0),       # sign kept: a curve continuous through 0
@@ -41,3 +42,16 @@ def test_wind_polar_stays_below_360():
     assert 0.0 <= from_deg < 360.0
     _, many = units.wind_polar(np.array([-5.0, 5.0]), np.array([0.0, 0.0]))
     np.testing.assert_allclose(many, [0.0, 180.0])
+
+
+def test_isa_is_one_formula():
+    """airdata's checked relations are the units formula itself (the ICAO table's 89874.6 Pa at
+    1000 m above), its inverse to rounding; unchecked beyond the troposphere, as the simulator
+    may need."""
+    from pitotcal.core import airdata
+    alt_m = np.linspace(-600.0, 11000.0, 13)
+    np.testing.assert_array_equal(airdata.static_pressure_pa(alt_m), units.isa_pressure_pa(alt_m))
+    ps = units.isa_pressure_pa(alt_m)
+    np.testing.assert_array_equal(airdata.pressure_altitude_m(ps), units.isa_altitude_m(ps))
+    np.testing.assert_allclose(units.isa_altitude_m(ps), alt_m, atol=1e-8)
+    assert np.isfinite(units.isa_pressure_pa(12000.0))

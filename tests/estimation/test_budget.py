@@ -95,3 +95,20 @@ def test_defaults_and_refusals(fitted):
                            u_qc_scale=0, u_qc_offset_pa=0)
     b = bd.uncertainty_budget(flight, result, zero)
     assert b.expanded_kt == pytest.approx(2 * b.statistical_kt)
+
+
+def test_resolves_are_identify_without_the_bounds(fitted):
+    """The budget re-solves with `estimate`: identify's parameters to the last bit (gates and
+    outlier trimming included: spikes put in here), only the bounds and checks skipped."""
+    from pitotcal.estimation.identification import estimate
+
+    flight, _ = fitted
+    qci = flight.qci_pa.copy()
+    qci[[500, 2500, 4500]] += 300.0
+    spiked = dataclasses.replace(flight, qci_pa=qci)
+    full, quick = identify(spiked), estimate(spiked)
+    assert any("trimmed as outliers" in w for w in full.warnings)
+    np.testing.assert_array_equal(quick.params, full.params)
+    np.testing.assert_array_equal(quick.residuals_pa, full.residuals_pa)
+    np.testing.assert_array_equal(quick.covariance, full.covariance_plain)
+    assert quick.consistency == {} and full.consistency

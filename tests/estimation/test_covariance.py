@@ -91,3 +91,45 @@ def test_reported_sigma_matches_the_scatter_of_estimates_under_projection():
     assert np.all(ratio > 0.85) and np.all(ratio < 1.2), ratio
     inside = np.abs(np.array(estimates)) < 2 * np.array(sigmas)
     assert np.all(inside.mean(axis=0) >= 0.88) and inside.mean() <= 0.99, inside.mean(axis=0)
+
+
+def _stretches_warning(n, seed, tau=40.0):
+    """The few-stretches warning of AR(1) residuals of correlation time `tau` samples."""
+    e = _ou(n, np.exp(-1.0 / tau), np.random.default_rng(seed))
+    return colored_covariance(np.column_stack([np.ones(n), np.linspace(-1, 1, n)]), e).warning
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_no_few_stretches_warning_when_the_record_holds_many(seed):
+    """Truth: 2 tau = (1 + a)/(1 - a) = 80 samples, 250 stretches in 20,000. The fitted noise
+    model's long-run-weighted time said ~6,300 samples for seed 2 (its slowest term at the
+    edge of its grid)."""
+    assert _stretches_warning(20000, seed) is None
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_few_stretches_warning_names_the_true_correlation(seed):
+    """Truth: 200 samples hold 2.5 stretches of 2 tau = 80 samples; the warning's length is
+    measured (a short record's autocorrelation reads short: 25-50 samples)."""
+    import re
+
+    warning = _stretches_warning(200, seed)
+    two_tau, stretches = map(float, re.match(r"residuals correlated over ~(\d+) samples: only "
+                                             r"~(\d+) independent stretches", warning).groups())
+    assert 20.0 <= two_tau <= 100.0 and stretches < 10
+
+
+@pytest.mark.parametrize("seed", [5, 10, 11])
+def test_no_few_stretches_warning_in_turbulence_the_record_resolves(seed):
+    """A 240 s flight in 0.5 m/s gusts of L = 300 m: the truth is 2 tau = 2 L / V ~ 14 s, ~18
+    stretches. These seeds were warned of ~3,100-3,900 samples (62-78 s) before the warning
+    measured the residuals themselves."""
+    from pitotcal.estimation import identify
+    from synthetic import synthetic_flight
+
+    flight, _ = synthetic_flight(seed=seed, n=12000, turns=2.0, turbulence_mps=0.5,
+                                 gps_rate_hz=5.0, gps_noise_mps=0.05, qc_noise_pa=0.5)
+    tas_mps = np.sqrt(2.0 * flight.qci_pa / flight.rho_kgm3)
+    a = np.exp(-1.0 / (50.0 * 300.0 / tas_mps.mean()))              # the gusts' AR(1), 50 Hz
+    assert flight.n / ((1 + a) / (1 - a)) >= 10                     # the truth: no warning
+    assert not [w for w in identify(flight).warnings if "independent stretches" in w]

@@ -41,20 +41,71 @@ def oat_k_from_c(oat_c):
     return oat_c + 273.15
 
 
-def check_output(flag, out, source, what):
-    """Refuse an output file on top of the input or in a missing folder, before any work.
+def check_outputs(outputs, inputs=(), *, figures=()):
+    """Refuse, before any work, an output a command must not or could not write: THE check of
+    every command's output paths.
 
-    `what` names the input in the message ("log", "flight file").
+    Parameters
+    ----------
+    outputs : dict
+        {flag: path, or None when not asked for}.
+    inputs : iterable of (path or None, str)
+        The command's input files, each with how a message names it ("the input log").
+    figures : iterable of str
+        The flags whose output is a matplotlib figure: a name without extension is written as
+        PNG, so ".png" is added before the checks, and the extension must be a format
+        matplotlib writes.
+
+    Returns
+    -------
+    dict
+        {flag: the path as written (as given, ".png" added to a figure's bare name), or None}.
+
+    Notes
+    -----
+    Each output in turn: not a folder, not an input (a hard link or symlink to it counts), its
+    folder exists and is writable, an existing file is writable; then no two outputs at one
+    path; then the figure formats.
     """
+    figures = set(figures)
+    written = {flag: None if path is None else _as_written(path, flag in figures)
+               for flag, path in outputs.items()}
+    for flag, out in written.items():
+        if out is not None:
+            _check_one(flag, Path(out), inputs)
+    check_distinct(written)
+    for flag in figures:
+        if written.get(flag) is not None:
+            check_figure_format(flag, outputs[flag])
+    return written
+
+
+def check_output(flag, out, source, what):
+    """`check_outputs` of one output and one input; `what` names the input ("log")."""
+    _check_one(flag, Path(out), [(source, f"the input {what}")])
+
+
+def _as_written(path, figure):
+    """The path a writer really writes: matplotlib adds ".png" to a name without extension."""
+    return f"{path}.png" if figure and not Path(path).suffix else path
+
+
+def _check_one(flag, out, inputs):
     from pitotcal.core.errors import PitotcalError
 
-    out = Path(out)
     if out.is_dir():
         raise PitotcalError(f"{flag} {out} is a folder: give the file to write")
-    if out.resolve() == Path(source).resolve() or _same_file(out, source):
-        raise PitotcalError(f"{flag} {out}: would overwrite the input {what}")
-    if not out.resolve().parent.is_dir():
+    for source, what in inputs:
+        if source is not None and (out.resolve() == Path(source).resolve()
+                                   or _same_file(out, source)):
+            raise PitotcalError(f"{flag} {out}: would overwrite {what}")
+    folder = out.resolve().parent
+    if not folder.is_dir():
         raise PitotcalError(f"{flag} {out}: directory {out.parent} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise PitotcalError(f"{flag} {out}: directory {out.parent} is not writable")
+    if out.exists() and not os.access(out, os.W_OK):
+        raise PitotcalError(f"{flag} {out}: the existing file is not writable")
 
 
 def check_figure_format(flag, path):

@@ -27,12 +27,12 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.cli.common import check_outputs, oat_k_from_c
     from pitotcal.io import write_flight_csv
     from pitotcal.io.logs import load_log
 
     src, out = Path(args.log), Path(args.output)
-    check_output("-o", out, src, "log")         # said before reading a large log
+    check_outputs({"-o": out}, [(src, "the input log")])    # said before reading a large log
     flog = load_log(src, args.start_s, args.end_s, gps_resample=args.gps_resample,
                     oat_k=oat_k_from_c(args.oat_c))
     flight = flog.flight

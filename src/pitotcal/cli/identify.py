@@ -188,19 +188,11 @@ def run(args):
 
 
 def _checked_outputs(args, source):
-    """Refuse, before the work, an output on the input, two outputs at one path, a folder or
-    a figure format matplotlib cannot write; the figure's path as written (".png" added)."""
-    from pitotcal.cli.common import check_distinct, check_figure_format, check_output
+    """`check_outputs` of --json, --plot and --params; the figure's path as written."""
+    from pitotcal.cli.common import check_outputs
 
-    for option, out in (("--json", args.json), ("--plot", args.plot), ("--params", args.params)):
-        if out is not None:
-            check_output(option, out, source, "flight file")
-    plot_path = None if args.plot is None else \
-        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-    check_distinct({"--json": args.json, "--plot": plot_path, "--params": args.params})
-    if args.plot is not None:
-        check_figure_format("--plot", args.plot)
-    return plot_path
+    outputs = {"--json": args.json, "--plot": args.plot, "--params": args.params}
+    return check_outputs(outputs, [(source, "the input flight file")], figures=["--plot"])["--plot"]
 
 
 def _read(args, source):
@@ -331,7 +323,7 @@ def _run_live(args):
     """`--live CONNECTION`: estimation.live.identify_stream, its updates on stderr."""
     import sys
 
-    from pitotcal.cli.common import check_output, oat_k_from_c
+    from pitotcal.cli.common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import choice, positive
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -344,9 +336,8 @@ def _run_live(args):
         raise PitotcalError("give either FLIGHT (a file) or --live CONNECTION, not both")
     choice("model", args.model, list(MODELS))
     positive("target_2sigma_kt", args.target_2sigma_kt)
-    for option, out in (("--json", args.json), ("--plot", args.plot)):
-        if out is not None:
-            check_output(option, out, args.live, "stream")
+    plot_path = check_outputs({"--json": args.json, "--plot": args.plot},
+                              [(args.live, "the input stream")], figures=["--plot"])["--plot"]
     met = []
 
     def show(fix, message):
@@ -378,7 +369,7 @@ def _run_live(args):
         out.update(_gps_error_record(_gps_error(args)))
         write_json(args.json, out)
         print(f"\nWrote {args.json}")
-    if args.plot is not None:
-        result.plot(args.plot)
-        print(f"Wrote {args.plot}")
+    if plot_path is not None:
+        result.plot(plot_path)
+        print(f"Wrote {plot_path}")
     return 0

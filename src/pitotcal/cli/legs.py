@@ -86,7 +86,7 @@ def _plot_path(args):
 
 
 def run(args):
-    from pitotcal.cli.common import check_distinct, check_output
+    from pitotcal.cli.common import check_outputs
     from pitotcal.core.checks import choice
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -97,12 +97,9 @@ def run(args):
     if not source.is_file():
         raise PitotcalError(f"{source}: no such file", param="legs")
     flight = _is_flight(source)
-    outputs = {"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out}
-    for option, out in outputs.items():
-        if out is not None:
-            check_output(option, out, source, "flight file" if flight else "leg file")
-    # matplotlib would append ".png" to a figure name without extension: that name counts
-    check_distinct({**outputs, "--plot": _plot_path(args)})
+    check_outputs({"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out},
+                  [(source, f"the input {'flight file' if flight else 'leg file'}")],
+                  figures=["--plot"])
     if flight:
         return _run_flight(args, source)
     given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out",

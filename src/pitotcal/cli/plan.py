@@ -68,8 +68,9 @@ def run(args):
 
     figures = not args.no_figures
     max_iter = MAX_ITER if args.max_iter is None else args.max_iter
-    check_output_paths(args.output, figures=figures)
+    paths = check_output_paths(args.output, figures=figures)
     geo = _geo_settings(args)
+    _check_outputs(args, paths)
     calibration = _calibration(args.calibration)
     design_options = _design_options(args)          # fills in --profile's default
     plan = plan_maneuver(
@@ -203,6 +204,19 @@ def _design_options(args):
             raise PitotcalError(f"{flag} is for --design optimal")
         return None
     return given
+
+
+def _check_outputs(args, paths):
+    """`check_outputs` of the plan's files and mission: none on --calibration, none twice."""
+    from pitotcal.cli.common import check_outputs
+
+    outputs = {"--output": paths["plan"]}
+    outputs.update({f"--output ({kind})": path for kind, path in paths.items() if kind != "plan"})
+    if args.export:
+        from pitotcal.maneuvers.missions import mission_path
+
+        outputs["--export"] = mission_path(args.output, args.export)
+    check_outputs(outputs, [(args.calibration, "the input calibration")])
 
 
 def _calibration(path):

@@ -46,20 +46,16 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_distinct, check_output, oat_k_from_c
+    from pitotcal.cli.common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import choice, number
     from pitotcal.estimation.calibration_report import make_report
 
     choice("regulation", args.regulation, REGULATION_CHOICES)
     source = Path(args.result)
     # every output against every input: none is ever written over
-    inputs = [(source, "result JSON"), (args.flight, "flight"),
-              (args.aircraft, "aircraft file")]
-    for option, out in (("-o", args.output), ("--json", args.json), ("--pdf", args.pdf)):
-        for path, what in inputs:
-            if out is not None and path is not None:
-                check_output(option, out, path, what)
-    check_distinct({"-o": args.output, "--json": args.json, "--pdf": args.pdf})
+    check_outputs({"-o": args.output, "--json": args.json, "--pdf": args.pdf},
+                  [(source, "the input result JSON"), (args.flight, "the input flight"),
+                   (args.aircraft, "the input aircraft file")])
     options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
     if args.temp_recovery is not None:
         number("temp_recovery", args.temp_recovery, 0.0, 1.0)

@@ -129,7 +129,7 @@ def _outputs(args):
     the flight even when the flight's name ends in .json."""
     from pathlib import Path
 
-    from pitotcal.cli.common import check_output
+    from pitotcal.cli.common import check_outputs
     from pitotcal.core.errors import PitotcalError
     from pitotcal.maneuvers.truth import truth_path_for
 
@@ -137,10 +137,8 @@ def _outputs(args):
     if out.suffix.lower() == ".json":
         raise PitotcalError(f"-o {args.output}: the flight is a CSV; name it FLIGHT.csv "
                             f"(the truth goes to {truth_out.name})")
-    for path in (out, truth_out):
-        if path.exists() and Path(args.plan).exists() and path.samefile(args.plan):
-            raise PitotcalError(f"-o {args.output}: would overwrite the plan {args.plan}")
-    check_output("-o", out, args.plan, "plan")          # a folder, or a missing folder
+    check_outputs({"-o": out, "-o (its truth file)": truth_out},
+                  [(args.plan, f"the plan {args.plan}")])
     return out, truth_out
 
 

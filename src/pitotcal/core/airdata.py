@@ -6,7 +6,8 @@
     H    = (T₀/L) [1 − (p_s/p₀)^(R L/g₀)]                   pressure altitude (geopotential)
 
 γ = 1.4, p₀ = 101,325 Pa, T₀ = 288.15 K, a₀ = sqrt(γ R T₀) = 340.294 m/s, L = 0.0065 K/m,
-R and g₀ from `pitotcal.core.units` (the one place of the atmosphere constants). 0.2 and 3.5
+R and g₀ from `pitotcal.core.units` (the one place of the atmosphere constants and of the ISA
+formula, which `static_pressure_pa` and `pressure_altitude_m` check the range of). 0.2 and 3.5
 are (γ − 1)/2 and γ/(γ − 1) for γ = 1.4.
 
 Each function takes `lib` (numpy by default, or `casadi`): only its `sqrt`, `sign` and `fabs`
@@ -26,12 +27,12 @@ import numpy as np
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import (
     FT_TO_M,
-    ISA_EXPONENT,
-    ISA_LAPSE_KPM,
     ISA_P0_PA,
     ISA_T0_K,
     R_AIR_JKGK,
     RHO0_KGM3,
+    isa_altitude_m,
+    isa_pressure_pa,
 )
 
 __all__ = [
@@ -256,7 +257,7 @@ def pressure_altitude_m(ps_pa, lib=np):
                                                          PRESSURE_ALTITUDE_MIN_M))
         _refuse_outside("ps_pa", ps_pa, lo * (1 - 1e-12), hi * (1 + 1e-12),
                         "the ISA troposphere")
-    return T0_K / ISA_LAPSE_KPM * (1.0 - (ps_pa / P0_PA) ** (1.0 / ISA_EXPONENT))
+    return isa_altitude_m(ps_pa, lib)
 
 
 def static_pressure_pa(pressure_altitude_m, lib=np):
@@ -268,7 +269,7 @@ def static_pressure_pa(pressure_altitude_m, lib=np):
     if _numeric(lib):
         _refuse_outside("pressure_altitude_m", pressure_altitude_m, PRESSURE_ALTITUDE_MIN_M,
                         PRESSURE_ALTITUDE_MAX_M, "the ISA troposphere")
-    return P0_PA * (1.0 - ISA_LAPSE_KPM * pressure_altitude_m / T0_K) ** ISA_EXPONENT
+    return isa_pressure_pa(pressure_altitude_m, lib)
 
 
 def altimeter_correction_m(dp_static_pa, pressure_altitude_ic_m, lib=np):

@@ -20,6 +20,7 @@ __all__ = [
     "ft_to_m",
     "incompressible_cas_mps",
     "incompressible_qc_pa",
+    "isa_altitude_m",
     "isa_density_kgm3",
     "isa_pressure_pa",
     "isa_temperature_k",
@@ -92,21 +93,42 @@ def incompressible_qc_pa(cas_mps):
     return 0.5 * RHO0_KGM3 * np.asarray(cas_mps, dtype=float) ** 2
 
 
-# International Standard Atmosphere, troposphere: for planning at an altitude (true airspeed
-# from calibrated) when no measured static pressure and temperature are at hand.
+# International Standard Atmosphere, troposphere: the one place of its formula. Unchecked, so the
+# simulator may evaluate it anywhere; `pitotcal.core.airdata` (static_pressure_pa,
+# pressure_altitude_m) adds the validity range and is what data should go through.
 ISA_T0_K = 288.15
 ISA_P0_PA = 101325.0
 ISA_LAPSE_KPM = 0.0065
 ISA_EXPONENT = G0_MPS2 / (R_AIR_JKGK * ISA_LAPSE_KPM)   # 5.2559: p/p0 = (T/T0)^n
 
 
-def isa_temperature_k(alt_m):
-    return ISA_T0_K - ISA_LAPSE_KPM * np.asarray(alt_m, dtype=float)
+def _floats(value, lib):
+    """A float array with numpy; a CasADi symbol as it is (`lib` is casadi)."""
+    return np.asarray(value, dtype=float) if lib is np else value
 
 
-def isa_pressure_pa(alt_m):
-    return ISA_P0_PA * (isa_temperature_k(alt_m) / ISA_T0_K) ** ISA_EXPONENT
+def isa_temperature_k(alt_m, lib=np):
+    """ISA temperature T = T₀ − L H, K, at a geopotential altitude H (m).
+
+    `lib` is numpy (the default) or casadi, as in `pitotcal.core.airdata`.
+    """
+    return ISA_T0_K - ISA_LAPSE_KPM * _floats(alt_m, lib)
+
+
+def isa_pressure_pa(alt_m, lib=np):
+    """ISA static pressure p = p₀ (T/T₀)^n, Pa, n = g₀/(R L), at a geopotential altitude (m)."""
+    return ISA_P0_PA * (isa_temperature_k(alt_m, lib) / ISA_T0_K) ** ISA_EXPONENT
+
+
+def isa_altitude_m(ps_pa, lib=np):
+    """ISA pressure altitude H = (T₀/L) [1 − (p/p₀)^(1/n)], m, of a static pressure (Pa).
+
+    The inverse of `isa_pressure_pa`.
+    """
+    ratio = _floats(ps_pa, lib) / ISA_P0_PA
+    return ISA_T0_K / ISA_LAPSE_KPM * (1.0 - ratio ** (1.0 / ISA_EXPONENT))
 
 
 def isa_density_kgm3(alt_m):
+    """ISA density ρ = p / (R T), kg/m³, at a geopotential altitude (m)."""
     return density_kgm3(isa_pressure_pa(alt_m), isa_temperature_k(alt_m))

@@ -31,7 +31,13 @@ import numpy as np
 
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.flight import Flight
-from pitotcal.core.units import R_AIR_JKGK, RHO0_KGM3, density_kgm3, isa_temperature_k
+from pitotcal.core.units import (
+    R_AIR_JKGK,
+    RHO0_KGM3,
+    density_kgm3,
+    isa_altitude_m,
+    isa_temperature_k,
+)
 
 from .resample import hold
 
@@ -229,8 +235,7 @@ def _density(d, oat, t_unix, ps, meta):
         return RHO0_KGM3 / np.interp(t_unix, cal["time_unix_s"], cal["EAS2TAS"]) ** 2
     if oat == "isa":
         # pressure altitude from the measured static pressure, then ISA temperature there
-        alt_p = 44330.77 * (1.0 - (ps / 101325.0) ** 0.190263)
-        temp = isa_temperature_k(alt_p)
+        temp = isa_temperature_k(isa_altitude_m(ps))
         meta["density"] = "ps / (R * T_ISA(pressure altitude))"
     else:
         temp = np.full(t_unix.size, oat)

@@ -56,7 +56,7 @@ from pitotcal.core.errors import FlightDataError
 from pitotcal.core.flight import Flight
 from pitotcal.core.moist_air import with_static_air
 from pitotcal.core.plan import PLAN_COLUMNS
-from pitotcal.core.units import density_kgm3
+from pitotcal.core.units import ISA_T0_K, density_kgm3
 
 from .atomic import atomic_open
 from .flight_checks import (
@@ -163,7 +163,7 @@ def read_flight_csv(path, start_s=None, end_s=None):
         check_vertical_speed(name, data[:, col["gps_vd_mps"]], vn, ve, time_s,
                              data[:, col["alt_m"]] if "alt_m" in col else None)
     if "ps_ref_pa" in col:
-        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, 288.15), column="ps_ref_pa")
+        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, ISA_T0_K), column="ps_ref_pa")
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
                 for c in (*OPTIONAL_COLUMNS, *STATIC_COLUMNS, *TEMPERATURE_COLUMNS)}
     flight = Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
