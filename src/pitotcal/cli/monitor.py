@@ -76,12 +76,7 @@ def run(args):
     import sys
     import warnings
 
-    from pitotcal.cli.common import (
-        check_distinct,
-        check_figure_format,
-        check_output,
-        oat_k_from_c,
-    )
+    from pitotcal.cli.common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import positive
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor import monitor
@@ -91,16 +86,10 @@ def run(args):
     from pitotcal.io.mavlink_live import is_connection
 
     source = Path(args.source)
-    for option, out in (("--json", args.json), ("--plot", args.plot)):
-        if out is not None:
-            check_output(option, out, source, "flight file")
-            check_output(option, out, args.calibration, "calibration")
-    # matplotlib would append ".png" to a figure name without extension: that name counts
-    plot_path = None if args.plot is None else \
-        args.plot if Path(args.plot).suffix else f"{args.plot}.png"
-    check_distinct({"--json": args.json, "--plot": plot_path, "--calibration": None})
-    if args.plot is not None:
-        check_figure_format("--plot", args.plot)
+    plot_path = check_outputs({"--json": args.json, "--plot": args.plot},
+                              [(source, "the input flight file"),
+                               (args.calibration, "the input calibration")],
+                              figures=["--plot"])["--plot"]
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
                           warmup_s=args.warmup_s,
