@@ -221,13 +221,17 @@ class SequentialTest:
         self.rho_y, self.y_prev = 0.0, None
         self.e_past = deque(maxlen=self.phi.size)     # e_{k-1}, e_{k-2}, ...
         self.ramp = RampTest(self.phi, self.block_s)
+        # below these each statistic is calm: the trackers may learn, an alarm ends
+        self.calm = {s: 0.5 * plan["h"][s] for s in CUSUMS}
+        self.calm["ramp"] = self.ramp.calm_level(plan["h"]["ramp"])
         self.values = dict.fromkeys(STATISTICS, 0.0)
         self.zero_s = dict.fromkeys(STATISTICS, None)
         self.open = set()
 
     def quiet(self, stats=STATISTICS):
-        """No statistic (of `stats`) above half its threshold: the data may teach the trackers."""
-        return all(self.values[s] < 0.5 * self.plan["h"][s] for s in stats)
+        """No statistic (of `stats`) above its calm level (half its threshold; the ramp
+        test's: `RampTest.calm_level`): the data may teach the trackers."""
+        return all(self.values[s] < self.calm[s] for s in stats)
 
     def step(self, t_s, e, log_band, learning, drift=0.0):
         """One block: `e` its residual (in the noise model's unit), `drift` the ramp test's
@@ -270,10 +274,10 @@ class SequentialTest:
         return tuple(fired), z, y
 
     def _ramp(self, t_s, z, learning, v):
-        """The ramp test: fires at log R > h, ends below h/2; its onset the likeliest τ."""
+        """The ramp test: fires at log R > h, ends below its calm level; onset the likeliest τ."""
         g, m, _ = self.ramp.update(z, v)
         h = self.plan["h"]["ramp"]
-        self.values["ramp"] = min(g, 0.5 * h) if learning else g
+        self.values["ramp"] = min(g, self.calm["ramp"]) if learning else g
         if learning:
             return []
         fired = []
@@ -281,7 +285,7 @@ class SequentialTest:
             self.open.add("ramp")
             self.zero_s["ramp"] = t_s - m * self.block_s
             fired.append("ramp")
-        elif "ramp" in self.open and g < 0.5 * h:
+        elif "ramp" in self.open and g < self.calm["ramp"]:
             self.open.discard("ramp")
         return fired
 

@@ -53,6 +53,15 @@ class RampTest:
         self.min_blocks = max(_MIN_BLOCKS, phi.size)   # the head's terms inside every window
         self.z = deque(maxlen=n)
 
+    def calm_level(self, h):
+        """The log R below which nothing is suspect (the trackers may learn, an alarm ends):
+        half the threshold h, as for the CUSUMs, but not below where log R sits when nothing
+        is wrong — R sums one likelihood ratio of mean 1 per onset in the window, so log R
+        hovers near log(onsets) (median 4.8, 99 % 6.3 on 2.8 clean hours with 357 onsets) —
+        and not above h."""
+        onsets = self.z.maxlen - self.min_blocks + 1
+        return min(max(0.5 * h, float(np.log(onsets)) + 1.0), h)
+
     def update(self, z, v):
         self.z.append(float(z))
         n = len(self.z)
