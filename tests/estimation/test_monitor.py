@@ -240,3 +240,25 @@ def test_still_cusum_on_correlated_liveness_keeps_its_design():
     assert 0.35 < test.rho_y < 0.8
     # alarms end when the statistic falls below h/2: count against run lengths of ~ARL
     assert 0.4 * n / arl <= alarms <= 1.6 * n / arl
+
+
+@pytest.mark.parametrize("rate", [0.02, 2.0, 20.0])
+def test_ramp_test_calm_on_clean_innovations(rate):
+    """On N(0,1) innovations the ramp test stays calm in nearly every block at any designed
+    rate, so the trackers keep learning (half the threshold, the CUSUMs' rule, fell below log
+    R's no-fault level ~log(onsets) at 2/h and froze them), and its calm level is below the
+    threshold."""
+    from pitotcal.estimation.monitor_cusum import SequentialTest
+
+    opts = MonitorOptions(false_alarms_per_hour=rate)
+    plan = design(opts, 0.5)
+    noise = {"ar1": 0.0, "ar": [0.0], "innovation_rel_std": 1.0, "band_log_mean": 0.0,
+             "band_log_std": 1.0}
+    test = SequentialTest(noise, plan, opts)
+    rng = np.random.default_rng(2)
+    calm = []
+    for k, x in enumerate(rng.standard_normal(1500)):
+        test.step(0.5 * k, x, 0.0, k < 60, drift=0.05)
+        calm.append(test.quiet(("ramp",)))
+    assert np.mean(calm[400:]) > 0.95      # half the threshold: 1.0, 0.94, 0.33
+    assert test.calm["ramp"] <= plan["h"]["ramp"]
