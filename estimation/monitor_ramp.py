@@ -18,7 +18,8 @@ average run length at γ blocks or more — the threshold is log γ, with no con
 The prior's scale is the drift the test is tuned to (`MonitorOptions.drift_kt_per_min`);
 integrating the slope over it, rather than maximising (a GLR), gives up little at that drift
 and lets the onsets' evidence add up: on the monitor study's 2 kt/min icing in 0.5 m/s
-turbulence it found the ramp 10–15 % sooner at the same false-alarm rate (docs/measured.md).
+turbulence (48 flights, the same airspeed innovations and budget share) the GLR found the ramp
+in 101 s median, this test in 89.7 s (docs/measured.md).
 """
 
 from collections import deque

@@ -7,7 +7,9 @@ turbulence, a different and drifting wind) and monitors it clean, then with each
 FAULTS from ONSET_S on (maneuvers.faults; the aircraft flies on as planned). The clean flight is
 monitored at several designed false-alarm rates, so the measured rate can be checked against
 the design where alarms are frequent enough to count, and the design extrapolated to where they
-are not; the one-sided 95 % Poisson upper bound states what the hours flown show alone.
+are not; the one-sided 95 % Poisson upper bound states what the hours flown show alone. Leak
+and icing faults are also given to an oracle (`monitor_oracle`): the delay no detector can
+expect to beat at the same false-alarm rate.
 """
 
 import functools
