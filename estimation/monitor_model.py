@@ -11,8 +11,8 @@ block grid (BLOCK_S): the relative residual e = (q_ci − predicted)/predicted o
 the same in airspeed, ΔV_i = e V_i/2 (the unit the monitor tests in: turbulence moves the
 airspeed by about the same m/s at every speed, so its fraction of q_ci changes along a speed
 sweep, and icing lowers V_i by kt/min), are autoregressive (turbulence is colored: correlation
-times of seconds), e_k = Σ φ_i e_{k−i} + w_k, and the log of the in-block (detrended) variance of the measured q_ci, the signal's high-frequency
-"liveness", is roughly normal. `pitotcal identify --json` writes it as ``"noise_model"``.
+times of seconds), e_k = Σ φ_i e_{k−i} + w_k, and the log of the in-block (detrended) variance
+of the measured q_ci, the signal's high-frequency "liveness", is roughly normal. `pitotcal identify --json` writes it as ``"noise_model"``.
 """
 
 from dataclasses import dataclass
@@ -31,7 +31,15 @@ from pitotcal.core.units import (
     wind_vector_mps,
 )
 
-__all__ = ["BLOCK_S", "Blocks", "Calibration", "block_stats", "noise_model", "predict_qci_pa"]
+__all__ = [
+    "BLOCK_S",
+    "Blocks",
+    "Calibration",
+    "airspeed_residual_mps",
+    "block_stats",
+    "noise_model",
+    "predict_qci_pa",
+]
 
 BLOCK_S = 0.5          # the monitor's block: long enough to average GPS noise, short for speed
 _MIN_PER_BLOCK = 4     # samples a block needs (the detrended variance has n - 2 dof)
@@ -196,8 +204,7 @@ def noise_model(result, block_s=BLOCK_S):
         raise PitotcalError(f"a noise model needs >= 10 blocks of {block_s:g} s, got {e.size}")
     e = e - e.mean()
     a, phi, w = _ar_model(e)
-    # the same in airspeed, ΔV_i = e V_i / 2 (V_i of the predicted q_ci): the monitor's unit
-    dv = e * 0.5 * incompressible_cas_mps(pred_b)
+    dv = airspeed_residual_mps(e, pred_b)      # the same in airspeed: the monitor's unit
     _, phi_v, w_v = _ar_model(dv - dv.mean())
     log_band = np.log(blocks.band_rel_var)
     return {"block_s": block_s, "rel_std": float(np.std(e)), "ar1": a, "ar": list(phi),
@@ -206,6 +213,12 @@ def noise_model(result, block_s=BLOCK_S):
             "innovation_std_mps": _robust_std(w_v),
             "band_log_mean": float(np.median(log_band)), "band_log_std": _robust_std(log_band),
             "n_blocks": int(e.size)}
+
+
+def airspeed_residual_mps(e, pred_pa):
+    """The relative residual `e` of q_ci as airspeed, ΔV_i = e V_i / 2 (q_ci ∝ V_i², V_i of the
+    predicted q_ci `pred_pa`), m/s: the unit the monitor tests in."""
+    return e * 0.5 * incompressible_cas_mps(pred_pa)
 
 
 def _ar_model(e):

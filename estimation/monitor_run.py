@@ -8,10 +8,10 @@ nothing is suspect — one step of the wind tracker (fast during the warm-up, th
 
 import numpy as np
 
-from pitotcal.core.units import incompressible_cas_mps, kt_to_mps
+from pitotcal.core.units import kt_to_mps
 
 from .monitor_cusum import STATISTICS, SequentialTest, WindTracker, design
-from .monitor_model import block_stats, predict_qci_pa
+from .monitor_model import airspeed_residual_mps, block_stats, predict_qci_pa
 
 __all__ = ["BlockLoop"]
 
@@ -73,11 +73,11 @@ class BlockLoop:
         learning = t - self.t0 < opts.warmup_s
         pred, grad = _predict_block(self.cal, inputs, j, wind.wind)
         e = (blocks.qci_pa[j] - pred) / pred
-        # the tests run on the residual in the noise model's unit: airspeed (q_ci ∝ V_i², so
-        # ΔV_i = e V_i / 2; turbulence and icing act on the speed, not on q_ci's fraction) or,
-        # for older calibrations, relative
-        per_e = 0.5 * float(incompressible_cas_mps(pred)) if test.velocity else 1.0
-        drift = self.drift_mps * (1.0 if test.velocity else 2.0 / float(incompressible_cas_mps(pred)))
+        # the tests run on the residual in the noise model's unit: airspeed (turbulence and
+        # icing act on the speed, not on q_ci's fraction) or, for older calibrations, relative
+        mps_per_e = float(airspeed_residual_mps(1.0, pred))
+        per_e, drift = (mps_per_e, self.drift_mps) if test.velocity else \
+            (1.0, self.drift_mps / mps_per_e)
         fired, z, y = test.step(t, e * per_e, np.log(max(blocks.band_rel_var[j], 1e-30)),
                                 learning, drift)
         r_var = (pred / per_e) ** 2 * test.sw2 * test.e_var_ratio

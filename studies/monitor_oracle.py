@@ -2,8 +2,9 @@
 effect on the monitor's residual (its size and shape), not its onset.
 
 The oracle sees what the monitor sees, the block residuals e (`monitor_model`; in airspeed,
-e V_i/2, when the calibration's noise model is), whitened with the calibration's AR coefficients, w_k = e_k − Σ φ_i e_{k−i}, and scaled by the flight's own
-innovation spread (it knows the noise level). It knows the fault's effect d_m on e, m blocks
+e V_i/2, when the calibration's noise model is), whitened with the calibration's AR
+coefficients, w_k = e_k − Σ φ_i e_{k−i}, and scaled by the flight's own innovation spread (it
+knows the noise level). It knows the fault's effect d_m on e, m blocks
 after the onset (taken from the same flight flown with and without the fault), so an onset at
 block j adds u_{k−j} = (d − Σ φ_i d_{−i})_{k−j} to the scaled innovation x_k. Its statistic is
 the Shiryaev–Roberts sum over onsets of the likelihood ratios,
@@ -21,8 +22,7 @@ limit fired on an innovation of −5.1 σ where the oracle expected −6.5 σ an
 """
 
 import numpy as np
-
-from pitotcal.core.units import incompressible_cas_mps
+from pitotcal.estimation.monitor_model import airspeed_residual_mps
 
 __all__ = ["oracle_delay_s"]
 
@@ -68,7 +68,7 @@ def oracle_delay_s(clean, spoiled, phi, onset_s, rate_per_hour, warmup_s, veloci
 def _residual(trace, velocity):
     """The trace's residual in the unit the monitor tests: ΔV_i = e V_i/2 (m/s) or e."""
     e = np.asarray(trace["e"], float)
-    return e * 0.5 * incompressible_cas_mps(trace["pred_pa"]) if velocity else e
+    return airspeed_residual_mps(e, trace["pred_pa"]) if velocity else e
 
 
 def _whiten(e, phi):

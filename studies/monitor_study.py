@@ -158,7 +158,8 @@ def headline(summary):
 def plot(rows, summary, out_dir):
     """Left, middle: median detection delay against leak and icing size per turbulence level
     (solid: the monitor; dashed: the fixed 2 m/s gate; dotted: the oracle told the fault,
-    `monitor_oracle`; a point only where at least half the runs detected it). Right: measured against designed false-alarm rate per condition."""
+    `monitor_oracle`; a point only where at least half the runs detected it). Right: measured
+    against designed false-alarm rate per condition."""
     fig, ax = new_figure(1, 3, size=(4.6, 3.8))
     faults = [r for r in rows if r.get("type") == "fault" and not r.get("error")]
     colors = dict(zip(CONDITIONS, ("C0", "C1", "C3", "C2")))
