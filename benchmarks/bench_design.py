@@ -22,9 +22,9 @@ def main(argv=None):
 
     import casadi  # noqa: F401  (import time is not planning time)
     import numpy as np
-    from pitotcal.maneuvers import planner
-    from pitotcal.maneuvers.design import default_noise, design_schedule
-    from pitotcal.maneuvers.planner import plan_maneuver
+    from pitotcal.maneuvers.plan import planner
+    from pitotcal.maneuvers.plan.design import default_noise, design_schedule
+    from pitotcal.maneuvers.plan.planner import plan_maneuver
 
     from pitotcal.core.units import wind_vector_mps
 

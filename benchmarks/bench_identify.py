@@ -49,7 +49,7 @@ def _flight(n, seed=0):
 def _scipy_fit(flight):
     """Yardstick: least_squares (lm, analytic Jacobian) on the same residual and start."""
     import numpy as np
-    from pitotcal.estimation.oe import start_values
+    from pitotcal.estimation.identification.oe import start_values
     from scipy.optimize import least_squares
 
     from pitotcal.core.models import get_model
@@ -76,7 +76,7 @@ def _scipy_fit(flight):
 
 def worker(n, repeats):
     """One N in this process: prints a JSON line of medians and the peak RSS."""
-    from pitotcal.estimation.oe import OutputErrorProblem
+    from pitotcal.estimation.identification.oe import OutputErrorProblem
 
     flight = _flight(n)
     problem = OutputErrorProblem("inverse")

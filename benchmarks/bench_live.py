@@ -77,8 +77,8 @@ def main():
     parser.add_argument("--samples", type=int, default=16000)
     args = parser.parse_args()
     from pitotcal.estimation import identify
-    from pitotcal.estimation.monitor import LiveMonitor
-    from pitotcal.estimation.monitor_model import Calibration
+    from pitotcal.estimation.monitor.monitoring import LiveMonitor
+    from pitotcal.estimation.monitor.model import Calibration
 
     flight = _flight(args.samples)
     buf = _buffer(flight)

@@ -53,8 +53,8 @@ def main(argv=None):
     r = args.repeats
 
     import casadi  # noqa: F401  (import time is not planning time)
-    from pitotcal.maneuvers import planner
-    from pitotcal.maneuvers.planner import ManeuverProblem, plan_maneuver
+    from pitotcal.maneuvers.plan import planner
+    from pitotcal.maneuvers.plan.planner import ManeuverProblem, plan_maneuver
 
     from pitotcal.core.errors import PlanInfeasibleError
 

@@ -4,7 +4,7 @@ Run: ``python benchmarks/bench_report.py [--repeats 5]``. In one process, median
 `--repeats` runs of: the report of a result JSON alone (two figures, template); the report with
 the flight and its fit (the paper-style figure and the track added); `result.plot()` to PNG (the
 existing calibration figure, the baseline the report figures are compared with); and
-`estimation.autopilot.recommend` (three fits) on a 16,000-sample synthetic flight.
+`estimation.reporting.autopilot_params.recommend` (three fits) on a 16,000-sample synthetic flight.
 """
 
 import argparse
@@ -25,8 +25,8 @@ def main():
     import io
 
     from pitotcal.estimation import identify
-    from pitotcal.estimation.autopilot import recommend
-    from pitotcal.estimation.calibration_report import build_report, render_html
+    from pitotcal.estimation.reporting.autopilot_params import recommend
+    from pitotcal.estimation.reporting.calibration_report import build_report, render_html
     from synthetic import synthetic_flight
 
     flight, _ = synthetic_flight(seed=0, n=16000, model="constant", k=(0.18,),

@@ -25,7 +25,8 @@ def _flight(n):
 def _plain():
     """The robust steps bypassed: identify as before issue 15."""
     import numpy as np
-    from pitotcal.estimation import consistency, robust
+    from pitotcal.estimation.robustness import consistency
+    from pitotcal.estimation.robustness import gates as robust
 
     return (mock.patch.object(robust, "gate_flight", lambda f: (f, ())),
             mock.patch.object(robust, "outliers", lambda r: np.zeros(len(r), dtype=bool)),

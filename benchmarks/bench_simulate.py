@@ -17,8 +17,8 @@ def main(argv=None):
     parser.add_argument("--rate-hz", type=float, default=50.0)
     args = parser.parse_args(argv)
 
-    from pitotcal.maneuvers.planner import plan_maneuver
-    from pitotcal.maneuvers.simulator import simulate
+    from pitotcal.maneuvers.plan.planner import plan_maneuver
+    from pitotcal.maneuvers.fly.simulator import simulate
 
     plan = plan_maneuver(duration_s=args.duration_s)
     simulate(plan, seed=0, rate_hz=args.rate_hz)               # warm-up: imports, control

@@ -3,8 +3,8 @@
 The public names; everything else is an implementation detail of its module.
 """
 
-from .identification import identify
-from .oe import OutputErrorProblem
-from .result import IdentificationResult
+from .identification.identify import identify
+from .identification.oe import OutputErrorProblem
+from .identification.result import IdentificationResult
 
 __all__ = ["IdentificationResult", "OutputErrorProblem", "identify"]

@@ -33,7 +33,7 @@ def monitor_stream(source, calibration, options=None, *, oat_k=None, idle_timeou
     `on_status(text)` gets a one-line status every second (samples, q_ci measured and
     predicted, alarms so far).
     """
-    from .monitor import LiveMonitor
+    from .monitor.monitoring import LiveMonitor
 
     live = LiveMonitor(calibration, options)
     raised = []
@@ -90,7 +90,7 @@ class LiveIdentifier:
     """
 
     def __init__(self, model="inverse", air="compressible", gps_error=None):
-        from .oe import OutputErrorProblem
+        from .identification.oe import OutputErrorProblem
 
         self.model, self.air = model, air
         self.gps_error = dict(gps_error or {})
@@ -100,7 +100,7 @@ class LiveIdentifier:
 
     def _stated(self, flight):
         """The stated GPS error as `identify` checks it against `flight` (None: no record yet)."""
-        from .identification import _gps_error
+        from .identification.identify import _gps_error
 
         return _gps_error(self.gps_error.get("gps_error_sigma_mps"),
                           self.gps_error.get("gps_error_tau_s"), flight)
@@ -108,14 +108,15 @@ class LiveIdentifier:
     def update(self, flight, warm=True):
         """The fit of `flight`; `warm=False` starts IPOPT from the linear least-squares start
         values (the cold start, for comparison)."""
-        from . import identification, robust
+        from .identification import identify as identification
+        from .robustness import gates
 
         if self.problem is None:
             return identification.identify(flight, model=self.model, air=self.air,
                                            **self.gps_error)
         air_data, _ = identification._air_data(flight, self.air)
         identification._check_flight(flight, air_data)
-        flight, _ = robust.gate_flight(flight)
+        flight, _ = gates.gate_flight(flight)
         identification._check_track(flight)
         result = self.problem.solve(flight, start=self.start if warm else None,
                                     air_data=air_data, gps_error=self._stated(flight))
@@ -131,7 +132,7 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
     (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`
     and the stated `gps_error`, as `LiveIdentifier` takes it) on every sample received, as
     offline. A bad `gps_error` is refused before the stream is opened."""
-    from .identification import identify
+    from .identification.identify import identify
 
     fixes = []
     live = LiveIdentifier(model, air, gps_error)

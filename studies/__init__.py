@@ -1,7 +1,7 @@
 """Studies: Monte Carlo over simulated flights (on Dask), the paper's figures reproduced, the
 real ALFA flight, the autopilots' calibrators compared, and `pitotcal demo`. Every study is one
 `studies.study.Study` in the table `studies.catalog.STUDIES`, each in its own module
-(`studies.coverage`...).
+(`studies.accuracy.coverage`...).
 
 Example
 -------

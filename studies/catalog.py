@@ -15,22 +15,22 @@ from pitotcal.core.checks import choice, integer
 from pitotcal.core.errors import PitotcalError
 from pitotcal.io.jsonfile import write_json
 
-from .budget_study import STUDY as BUDGET
-from .compare_peers import STUDY as PEERS
-from .coverage import STUDY as COVERAGE
-from .design_study import STUDY as DESIGN
-from .leak_study import STUDY as LEAK
-from .legs_flight_study import STUDY as LEGS_FLIGHT
-from .legs_study import STUDY as LEGS
-from .maneuvers_study import STUDY as MANEUVERS
-from .monitor_study import STUDY as MONITOR
-from .noise import STUDY as NOISE
-from .real_alfa import STUDY as REAL_ALFA
+from .accuracy.budget import STUDY as BUDGET
+from .peers.study import STUDY as PEERS
+from .accuracy.coverage import STUDY as COVERAGE
+from .design.study import STUDY as DESIGN
+from .accuracy.leak import STUDY as LEAK
+from .legs.flight_study import STUDY as LEGS_FLIGHT
+from .legs.study import STUDY as LEGS
+from .accuracy.maneuvers import STUDY as MANEUVERS
+from .monitor.study import STUDY as MONITOR
+from .accuracy.noise import STUDY as NOISE
+from .real_alfa.study import STUDY as REAL_ALFA
 from .runner import RunsInterrupted, count_errors, output_folder, write_table
-from .sample_size import STUDY as SAMPLE_SIZE
-from .sensitivity import STUDY as SENSITIVITY
+from .accuracy.sample_size import STUDY as SAMPLE_SIZE
+from .accuracy.sensitivity import STUDY as SENSITIVITY
 from .study import StudySettings
-from .wind import STUDY as WIND
+from .accuracy.wind import STUDY as WIND
 
 __all__ = ["STUDIES", "StudyInterrupted", "get_study", "rerun", "run_study", "study_names"]
 

@@ -48,7 +48,7 @@ class DemoResult:
     table : list of dict
         Rows {vi_kt, dv_kt, dv_2sigma_kt, dv_true_kt} over the flown range.
     result : pitotcal.IdentificationResult
-    truth : pitotcal.maneuvers.truth.Truth
+    truth : pitotcal.maneuvers.fly.truth.Truth
         The simulator's truth.
     timing_s : dict
         Seconds spent planning, simulating, identifying, writing and making the report.
@@ -83,8 +83,8 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     import time
 
     from pitotcal.estimation import identify
-    from pitotcal.estimation.budget import uncertainty_budget
-    from pitotcal.estimation.budget_report import add_budget
+    from pitotcal.estimation.uncertainty.budget import uncertainty_budget
+    from pitotcal.estimation.reporting.budget_tables import add_budget
     from pitotcal.maneuvers import plan_maneuver, simulate, write_truth_json
 
     from pitotcal.io import write_flight_csv, write_plan
@@ -159,7 +159,7 @@ def _report(result, flight, files, out):
     """The calibration report of the result just identified (no second identification)."""
     import json
 
-    from pitotcal.estimation.calibration_report import build_report, render_html
+    from pitotcal.estimation.reporting.calibration_report import build_report, render_html
 
     doc = json.loads(files["result_json"].read_text())
     options = {"command": "pitotcal demo", "regulation": "23.1323",

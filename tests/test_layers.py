@@ -103,7 +103,7 @@ def _cycle(graph):
 
 
 def test_the_graph_sees_every_layer(graph):
-    assert {"pitotcal.estimation.oe", "pitotcal.maneuvers", "pitotcal.studies"} <= set(graph)
+    assert {"pitotcal.estimation.identification.oe", "pitotcal.maneuvers", "pitotcal.studies"} <= set(graph)
     assert "pitotcal.io.streams" in graph["pitotcal.io.logs"]
     assert "pitotcal.io.resample" in graph["pitotcal.io.timebase"]
     assert "pitotcal.core.measurement" in graph["pitotcal.io.flight_checks"]

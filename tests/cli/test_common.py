@@ -33,7 +33,7 @@ def test_check_outputs_returns_the_paths_as_written(tmp_path):
 
 
 def test_an_unwritable_folder_or_file_is_refused(tmp_path, monkeypatch):
-    """Only `plan` checked this before (maneuvers.outputs.check_output_paths); monkeypatched
+    """Only `plan` checked this before (maneuvers.plan.outputs.check_output_paths); monkeypatched
     because root may write anywhere."""
     from pitotcal.cli import common
 

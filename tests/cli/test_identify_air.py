@@ -12,7 +12,7 @@ from pitotcal.io import read_flight, write_flight_csv
 
 @pytest.fixture(scope="module")
 def compressible_csv(tmp_path_factory):
-    from pitotcal.maneuvers.simulator import simulate
+    from pitotcal.maneuvers.fly.simulator import simulate
 
     plan = circle_plan(duration_s=240.0, cas_kt=(90.0, 150.0), radius_m=1500.0,
                        altitude_m=2438.4, wind_speed_mps=5.0)

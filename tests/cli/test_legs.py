@@ -5,7 +5,7 @@ import json
 from pathlib import Path
 
 import pytest
-from pitotcal.estimation.legs_report import POINT_KEYS
+from pitotcal.estimation.legs.report import POINT_KEYS
 
 from pitotcal.cli import main
 

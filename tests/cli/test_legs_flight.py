@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 import pytest
-from pitotcal.maneuvers.legs_sim import LEGS_TRUE_K, simulate_leg_flight
+from pitotcal.maneuvers.fly.legs import LEGS_TRUE_K, simulate_leg_flight
 
 from pitotcal.cli import main
 from pitotcal.io.flight_csv import write_flight_csv

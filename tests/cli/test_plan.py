@@ -86,7 +86,7 @@ def test_refusals_exit_2_one_line_naming_the_flag(argv, message, tmp_path, capsy
 ])
 def test_output_checked_before_solving(tmp_path, capsys, monkeypatch, target, message):
     """Item 7 of issue 8: the output folder was checked only after the solve."""
-    from pitotcal.maneuvers import planner
+    from pitotcal.maneuvers.plan import planner
 
     def no_solve(*args, **kwargs):
         raise AssertionError("planned before checking the output")
@@ -155,7 +155,7 @@ def test_export_ardupilot_beside_the_plan(tmp_path, capsys):
      "--magvar-deg: magvar_deg 200 must be >= -180 and <= 180"),
 ])
 def test_geo_options_checked_before_solving(argv, message, tmp_path, capsys, monkeypatch):
-    from pitotcal.maneuvers import planner
+    from pitotcal.maneuvers.plan import planner
 
     monkeypatch.setattr(planner, "plan_maneuver", None)
     assert main(["plan", *argv, "--no-figures", "-o", str(tmp_path / "p.csv")]) == 2

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from pitotcal.maneuvers.legs_sim import simulate_legs
+from pitotcal.maneuvers.fly.legs import simulate_legs
 
 from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError

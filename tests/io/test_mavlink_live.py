@@ -7,10 +7,10 @@ import pytest
 from mavsend import as_sent, free_udp_port, send_flight
 from pitotcal.estimation import identify
 from pitotcal.estimation.live import identify_stream, monitor_stream
-from pitotcal.estimation.monitor import monitor
-from pitotcal.estimation.monitor_model import Calibration
+from pitotcal.estimation.monitor.monitoring import monitor
+from pitotcal.estimation.monitor.model import Calibration
 from pitotcal.maneuvers import simulate
-from pitotcal.maneuvers.faults import Fault, apply_fault
+from pitotcal.maneuvers.fly.faults import Fault, apply_fault
 from plans import circle_plan
 
 from pitotcal.core.errors import FlightDataError

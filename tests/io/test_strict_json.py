@@ -33,7 +33,7 @@ def test_plan_settings_with_nan_are_written_as_null(tmp_path):
 
 
 def test_the_autothrottle_csv_header_is_strict_json(tmp_path):
-    from pitotcal.maneuvers.outputs import write_autothrottle_csv
+    from pitotcal.maneuvers.plan.outputs import write_autothrottle_csv
 
     plan = circle_plan(duration_s=20.0)
     plan.settings["cas_max_kt"] = float("inf")

@@ -5,7 +5,7 @@ from pathlib import Path
 
 
 def add_parser(subparsers):
-    from pitotcal.cli.common import add_reading_arguments
+    from .common import add_reading_arguments
 
     p = subparsers.add_parser(
         "convert", help="convert a PX4 .ulg or ArduPilot .bin/.log to a flight CSV",
@@ -27,7 +27,7 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_outputs, oat_k_from_c
+    from .common import check_outputs, oat_k_from_c
     from pitotcal.io import write_flight_csv
     from pitotcal.io.logs import load_log
 

@@ -14,7 +14,7 @@ AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_D
 
 
 def add_parser(subparsers):
-    from pitotcal.cli.common import add_reading_arguments
+    from .common import add_reading_arguments
 
     p = subparsers.add_parser(
         "identify", help="identify the pressure error and the wind from a flight",
@@ -114,7 +114,7 @@ _BUDGET_FLAGS = (
 
 def _budget_inputs(args):
     from pitotcal.core.checks import number
-    from pitotcal.estimation.budget import inputs_from_options
+    from pitotcal.estimation.uncertainty.budget import inputs_from_options
 
     scale = number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0)
     if args.u_rh_percent is not None:
@@ -135,8 +135,8 @@ def run(args):
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
     from pitotcal.estimation import identify
-    from pitotcal.estimation.budget import uncertainty_budget
-    from pitotcal.estimation.budget_report import budget_summary
+    from pitotcal.estimation.uncertainty.budget import uncertainty_budget
+    from pitotcal.estimation.reporting.budget_tables import budget_summary
     from pitotcal.io import is_log_file
 
     choice("model", args.model, [*MODELS, "auto"])
@@ -189,7 +189,7 @@ def run(args):
 
 def _checked_outputs(args, source):
     """`check_outputs` of --json, --plot and --params; the figure's path as written."""
-    from pitotcal.cli.common import check_outputs
+    from .common import check_outputs
 
     outputs = {"--json": args.json, "--plot": args.plot, "--params": args.params}
     return check_outputs(outputs, [(source, "the input flight file")], figures=["--plot"])["--plot"]
@@ -198,7 +198,7 @@ def _checked_outputs(args, source):
 def _read(args, source):
     """(Flight with static air temperature, autopilot, current parameters): the autopilot
     and its parameters only with --params (None, {} otherwise)."""
-    from pitotcal.cli.common import oat_k_from_c
+    from .common import oat_k_from_c
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.moist_air import with_static_air
     from pitotcal.io import read_flight
@@ -236,7 +236,7 @@ def _write_plot(path, result, budget):
     if budget is None:
         result.plot(path)
         return
-    from pitotcal.estimation.budget_report import plot_budget_band
+    from pitotcal.estimation.reporting.budget_tables import plot_budget_band
     from pitotcal.io.atomic import save_figure
 
     fig = result.plot()
@@ -246,7 +246,7 @@ def _write_plot(path, result, budget):
 
 def _write_params(args, flight, autopilot, current):
     """The recommended airspeed parameter, or a PitotcalError (exit 2) saying why not."""
-    from pitotcal.estimation.autopilot import PARAMETER, recommend, write_parameter_file
+    from pitotcal.estimation.reporting.autopilot_params import PARAMETER, recommend, write_parameter_file
 
     name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
         if autopilot == "PX4" else None
@@ -274,7 +274,7 @@ def _gps_error(args):
 def _reading(args):
     """JSON "reading": how the flight was read and its air made (`pitotcal report --flight`
     reads it the same way unless told otherwise)."""
-    from pitotcal.cli.common import oat_k_from_c
+    from .common import oat_k_from_c
 
     return {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c),
             "temp_recovery": args.temp_recovery, "rh_pct": args.rh_percent}
@@ -282,7 +282,7 @@ def _reading(args):
 
 def _write_json(path, result, flight, source, budget=None, gps_error=None, reading=None):
     """The result JSON, with every warning the reader gave in its "warnings"."""
-    from pitotcal.estimation.budget_report import add_budget
+    from pitotcal.estimation.reporting.budget_tables import add_budget
     from pitotcal.io.jsonfile import json_ready, write_json
 
     out = {**result.to_dict(), "source": str(source), "n_dropped": int(flight.n_dropped)}
@@ -309,9 +309,9 @@ def _gps_error_record(gps_error):
 
 def _monitor_noise_model(result):
     """{"noise_model": ...}: the residuals' noise model that `pitotcal monitor` designs its
-    thresholds from (estimation.monitor_model.noise_model); {} for a record too short."""
+    thresholds from (estimation.monitor.model.noise_model); {} for a record too short."""
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.estimation.monitor_model import noise_model
+    from pitotcal.estimation.monitor.model import noise_model
 
     try:
         return {"noise_model": noise_model(result)}
@@ -323,7 +323,7 @@ def _run_live(args):
     """`--live CONNECTION`: estimation.live.identify_stream, its updates on stderr."""
     import sys
 
-    from pitotcal.cli.common import check_outputs, oat_k_from_c
+    from .common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import choice, positive
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS

@@ -13,7 +13,7 @@ from pathlib import Path
 
 WIND_CHOICES = ("per-band", "per-point")
 LOG_SUFFIXES = (".ulg", ".bin", ".log")
-# Detection options: flag -> (keyword of estimation.legs_flight.detect_segments, help).
+# Detection options: flag -> (keyword of estimation.legs.flight.detect_segments, help).
 DETECT_FLAGS = {
     "--min-leg-s": ("min_leg_s", "shortest steady segment kept as a leg, s"),
     "--track-tol-deg": ("track_tol_deg", "track must stay within ± this, deg"),
@@ -24,7 +24,7 @@ DETECT_FLAGS = {
 
 
 def add_parser(subparsers):
-    from pitotcal.cli.common import add_reading_arguments
+    from .common import add_reading_arguments
 
     p = subparsers.add_parser(
         "legs", help="calibrate from GPS legs (3-leg, 4-leg) per point and globally",
@@ -61,7 +61,7 @@ def add_parser(subparsers):
 
 
 def _default(key):
-    # the values of estimation.legs_flight.DETECT_DEFAULTS, without importing numpy here
+    # the values of estimation.legs.flight.DETECT_DEFAULTS, without importing numpy here
     return {"min_leg_s": 30, "track_tol_deg": 3, "groundspeed_tol_kt": 3, "ias_tol_kt": 2,
             "smooth_s": 5}[key]
 
@@ -86,7 +86,7 @@ def _plot_path(args):
 
 
 def run(args):
-    from pitotcal.cli.common import check_outputs
+    from .common import check_outputs
     from pitotcal.core.checks import choice
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -112,7 +112,7 @@ def run(args):
 
 
 def _run_legs(args, source):
-    from pitotcal.estimation.legs_report import analyze_legs, legs_json, legs_summary, plot_legs
+    from pitotcal.estimation.legs.report import analyze_legs, legs_json, legs_summary, plot_legs
     from pitotcal.io.jsonfile import write_json
     from pitotcal.io.legs_csv import read_legs
 
@@ -134,7 +134,7 @@ def _run_legs(args, source):
 
 def _windows(text):
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.estimation.legs_flight import parse_windows, read_windows
+    from pitotcal.estimation.legs.flight import parse_windows, read_windows
 
     if text is None:
         return None
@@ -146,10 +146,10 @@ def _windows(text):
 
 
 def _run_flight(args, source):
-    from pitotcal.cli.common import oat_k_from_c
+    from .common import oat_k_from_c
     from pitotcal.core.checks import number
-    from pitotcal.estimation.legs_flight import analyze_leg_flight
-    from pitotcal.estimation.legs_report import (
+    from pitotcal.estimation.legs.flight import analyze_leg_flight
+    from pitotcal.estimation.legs.report import (
         flight_legs_json,
         flight_legs_text,
         legs_summary,

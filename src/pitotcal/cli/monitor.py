@@ -9,7 +9,7 @@ from pathlib import Path
 
 
 def add_parser(subparsers):
-    from pitotcal.cli.common import add_reading_arguments
+    from .common import add_reading_arguments
 
     p = subparsers.add_parser(
         "monitor", help="test a flight's airspeed against a calibration (health monitoring)",
@@ -48,7 +48,7 @@ def _read_calibration(path):
     import json
 
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.estimation.monitor_model import Calibration
+    from pitotcal.estimation.monitor.model import Calibration
 
     try:
         data = json.loads(Path(path).read_text())
@@ -76,11 +76,11 @@ def run(args):
     import sys
     import warnings
 
-    from pitotcal.cli.common import check_outputs, oat_k_from_c
+    from .common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import positive
     from pitotcal.estimation.live import monitor_stream
-    from pitotcal.estimation.monitor import monitor
-    from pitotcal.estimation.monitor_cusum import MonitorOptions
+    from pitotcal.estimation.monitor.monitoring import monitor
+    from pitotcal.estimation.monitor.cusum import MonitorOptions
     from pitotcal.io import read_flight
     from pitotcal.io.jsonfile import write_json
     from pitotcal.io.mavlink_live import is_connection

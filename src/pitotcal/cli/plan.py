@@ -62,9 +62,9 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.maneuvers.autothrottle import autothrottle_report
-    from pitotcal.maneuvers.outputs import check_output_paths, write_plan_outputs
-    from pitotcal.maneuvers.planner import MAX_ITER, check_converged, plan_maneuver
+    from pitotcal.maneuvers.plan.autothrottle import autothrottle_report
+    from pitotcal.maneuvers.plan.outputs import check_output_paths, write_plan_outputs
+    from pitotcal.maneuvers.plan.planner import MAX_ITER, check_converged, plan_maneuver
 
     figures = not args.no_figures
     max_iter = MAX_ITER if args.max_iter is None else args.max_iter
@@ -85,12 +85,12 @@ def run(args):
     mission = None
     if args.export:
         # refused (the loiter's bank or heading coverage) before any file is written
-        from pitotcal.maneuvers.missions import build_mission
+        from pitotcal.maneuvers.plan.missions import build_mission
 
         mission = build_mission(plan, *args.center, altitude_ref=args.altitude_ref)
     paths = write_plan_outputs(plan, args.output, figures=figures)
     if mission is not None:
-        from pitotcal.maneuvers.missions import mission_path, write_mission
+        from pitotcal.maneuvers.plan.missions import mission_path, write_mission
 
         paths["mission"] = write_mission(mission, mission_path(args.output, args.export),
                                          args.export)
@@ -138,7 +138,7 @@ def _geo_settings(args):
     if args.export:
         from pathlib import Path
 
-        from pitotcal.maneuvers.missions import mission_path
+        from pitotcal.maneuvers.plan.missions import mission_path
 
         target = mission_path(args.output, args.export)
         if target.resolve() == Path(args.output).resolve():
@@ -208,12 +208,12 @@ def _design_options(args):
 
 def _check_outputs(args, paths):
     """`check_outputs` of the plan's files and mission: none on --calibration, none twice."""
-    from pitotcal.cli.common import check_outputs
+    from .common import check_outputs
 
     outputs = {"--output": paths["plan"]}
     outputs.update({f"--output ({kind})": path for kind, path in paths.items() if kind != "plan"})
     if args.export:
-        from pitotcal.maneuvers.missions import mission_path
+        from pitotcal.maneuvers.plan.missions import mission_path
 
         outputs["--export"] = mission_path(args.output, args.export)
     check_outputs(outputs, [(args.calibration, "the input calibration")])

@@ -10,7 +10,7 @@ REGULATION_CHOICES = ("23.1323", "25.1323", "none")
 
 
 def add_parser(subparsers):
-    from pitotcal.cli.common import add_reading_arguments
+    from .common import add_reading_arguments
 
     p = subparsers.add_parser(
         "report", help="write the calibration report (HTML, optionally PDF) from a result JSON",
@@ -46,9 +46,9 @@ def add_parser(subparsers):
 
 
 def run(args):
-    from pitotcal.cli.common import check_outputs, oat_k_from_c
+    from .common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import choice, number
-    from pitotcal.estimation.calibration_report import make_report
+    from pitotcal.estimation.reporting.calibration_report import make_report
 
     choice("regulation", args.regulation, REGULATION_CHOICES)
     source = Path(args.result)

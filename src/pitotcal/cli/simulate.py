@@ -57,7 +57,7 @@ def add_parser(subparsers):
                         "six-degree-of-freedom model, its atmosphere and Milspec turbulence")
     e.add_argument("--aircraft", default=None,
                    help="JSBSim aircraft (default c172x, the Cessna 172); --engine jsbsim only")
-    f = p.add_argument_group("fault (maneuvers.faults)")
+    f = p.add_argument_group("fault (maneuvers.fly.faults)")
     f.add_argument("--fault", metavar="KIND:ONSET_S:SIZE", default=None,
                    help="spoil the pitot-static record from ONSET_S on: blocked (SIZE drain "
                         "time constant s, 0 frozen), static (SIZE s, 0 sealed), leak (SIZE "
@@ -129,9 +129,9 @@ def _outputs(args):
     the flight even when the flight's name ends in .json."""
     from pathlib import Path
 
-    from pitotcal.cli.common import check_outputs
+    from .common import check_outputs
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.maneuvers.truth import truth_path_for
+    from pitotcal.maneuvers.fly.truth import truth_path_for
 
     out, truth_out = Path(args.output), truth_path_for(args.output)
     if out.suffix.lower() == ".json":
@@ -151,14 +151,14 @@ def _engine(args):
     if args.engine == "own":
         if args.aircraft is not None:
             raise PitotcalError("--aircraft: only --engine jsbsim flies an aircraft model")
-        from pitotcal.maneuvers.simulator import simulate
+        from pitotcal.maneuvers.fly.simulator import simulate
 
         return simulate
     if args.air_data not in (None, "compressible"):
         raise PitotcalError(f"--air-data {args.air_data}: JSBSim's impact pressure is its own "
                             "isentropic total pressure minus static (compressible)")
-    from pitotcal.maneuvers.jsbsim_engine import DEFAULT_AIRCRAFT
-    from pitotcal.maneuvers.jsbsim_flight import simulate_jsbsim
+    from pitotcal.maneuvers.fly.jsbsim_engine import DEFAULT_AIRCRAFT
+    from pitotcal.maneuvers.fly.jsbsim_flight import simulate_jsbsim
 
     return partial(simulate_jsbsim, aircraft=args.aircraft or DEFAULT_AIRCRAFT)
 
@@ -168,13 +168,13 @@ def run(args):
 
     from pitotcal.io import write_flight_csv
     from pitotcal.io.plan_csv import read_plan
-    from pitotcal.maneuvers.truth import tracking_warnings, write_truth_json
+    from pitotcal.maneuvers.fly.truth import tracking_warnings, write_truth_json
 
     model, k = _true_k(args)
     out, truth_out = _outputs(args)
     fault = None
     if args.fault is not None:
-        from pitotcal.maneuvers.faults import parse_fault
+        from pitotcal.maneuvers.fly.faults import parse_fault
         fault = parse_fault(args.fault, seed=args.seed)
     plan = read_plan(args.plan)
     flight, truth = _engine(args)(
@@ -191,13 +191,13 @@ def run(args):
         gps_gm_tau_s=args.gps_gm_tau_s, **_air_sensor_option(args),
         **({"vertical_gusts": True} if args.vertical_gusts else {}))
     if fault is not None:
-        from pitotcal.maneuvers.faults import apply_fault
+        from pitotcal.maneuvers.fly.faults import apply_fault
         flight = apply_fault(flight, truth, fault)
     write_flight_csv(flight, out, comments={"plan": str(args.plan)})
     truth_path = write_truth_json(truth, truth_out)
     if fault is not None:
         from pitotcal.io.jsonfile import write_json
-        from pitotcal.maneuvers.faults import truth_with_fault
+        from pitotcal.maneuvers.fly.faults import truth_with_fault
         write_json(truth_path, truth_with_fault(truth, fault))
     print(f"wrote {args.output} ({flight.n} samples, {flight.time_s[-1] - flight.time_s[0]:.0f} s)"
           f" and {truth_path}")

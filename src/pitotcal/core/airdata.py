@@ -24,8 +24,8 @@ import math
 
 import numpy as np
 
-from pitotcal.core.errors import PitotcalError
-from pitotcal.core.units import (
+from .errors import PitotcalError
+from .units import (
     FT_TO_M,
     ISA_P0_PA,
     ISA_T0_K,
@@ -161,7 +161,7 @@ def qc_from_total_pa(tas_sq, pt_pa, oat_k, lib=np):
 
         q_c = p_T [1 − (1 + 0.2 M²)^−3.5],   M² = V_t² / (γ R T_s).
 
-    The calibration's prediction (`estimation.residual`): the static port reads
+    The calibration's prediction (`estimation.identification.residual`): the static port reads
     p_s,ind = p_s + Δp_p and the transducer q_ci = q_c − Δp_p, so their sum p_s,ind + q_ci is
     the true total pressure whatever the static-source error, and q_c follows from V_t
     without knowing Δp_p. As M → 0 this tends to ½ρV_t² with ρ = p_T / (R T_s).

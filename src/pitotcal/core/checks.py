@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from pitotcal.core.errors import PitotcalError
+from .errors import PitotcalError
 
 __all__ = ["choice", "exact", "integer", "number", "option_dict", "positive", "round_to_limit",
            "wrap_deg"]

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pitotcal.core.scenario import ALT_TOLERANCE_FT, CAS_TOLERANCE_KT
-from pitotcal.core.units import FT_TO_M, G0_MPS2
+from .scenario import ALT_TOLERANCE_FT, CAS_TOLERANCE_KT
+from .units import FT_TO_M, G0_MPS2
 
 __all__ = ["CONTROL_NAMES", "STATE_NAMES", "Limits", "rhs"]
 

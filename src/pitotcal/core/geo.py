@@ -7,7 +7,7 @@ at 2 km).
 
 import math
 
-from pitotcal.core.checks import number
+from .checks import number
 
 __all__ = ["WGS84_A_M", "WGS84_F", "check_lat_lon", "latlon_from_offset_m", "latlon_text",
            "offset_m_from_latlon", "radii_of_curvature_m"]

@@ -13,7 +13,7 @@ tau = L_u / V), s_i the white part (transducer and GPS noise per grid sample). T
 least squares, so its covariance is the sandwich (J^T J)^-1 J^T Sigma J (J^T J)^-1 - what the
 colored-residual covariance of `estimation` estimates from the residuals after the flight.
 
-`gust_covariance` writes the same residual as `estimation.noise_model` does: a velocity
+`gust_covariance` writes the same residual as `estimation.uncertainty.residual_noise` does: a velocity
 disturbance reaching q_ci through the wind sensitivities w_i (the last two columns of J), the
 along-path gust g_i as |w_i| g_i and the GPS velocity noise as white noise of variance
 |w_i|^2 sigma_gps^2, plus the transducer's white noise; `reported_covariance` widens the
@@ -25,9 +25,9 @@ numpy only; no import of maneuvers or estimation (layers).
 
 import numpy as np
 
-from pitotcal.core.measurement import impact_pressure_pa, tas_squared
-from pitotcal.core.models import delta_v_kt, qci_from_qc_pa
-from pitotcal.core.propagation import band, gradient
+from .measurement import impact_pressure_pa, tas_squared
+from .models import delta_v_kt, qci_from_qc_pa
+from .propagation import band, gradient
 
 __all__ = [
     "DOF_TAUS",
@@ -47,7 +47,7 @@ __all__ = [
 ]
 
 # Degrees of freedom of the fitted model's long-run variance (Student-t widening): one per
-# long-run-weighted correlation time in the record (estimation.noise_model and the design's
+# long-run-weighted correlation time in the record (estimation.uncertainty.residual_noise and the design's
 # prediction both use it). Measured on 60 flights per case (GPS 0.5 m/s
 # + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
 # module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
@@ -260,7 +260,7 @@ def normal_isf(p):
 
 def student_t_widening(dof, z=2.0):
     """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
-    dof >= 3); 1 for infinite dof. The estimator's widening too (`estimation.covariance`)."""
+    dof >= 3); 1 for infinite dof. The estimator's widening too (`estimation.uncertainty.covariance`)."""
     if not np.isfinite(dof):
         return 1.0
     v = max(float(dof), 3.0)

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pitotcal.core import airdata
-from pitotcal.core.units import incompressible_cas_mps, incompressible_qc_pa, kt_to_mps, mps_to_kt
+from . import airdata
+from .units import incompressible_cas_mps, incompressible_qc_pa, kt_to_mps, mps_to_kt
 
 __all__ = [
     "MODELS",

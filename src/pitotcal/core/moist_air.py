@@ -25,10 +25,10 @@ import warnings
 
 import numpy as np
 
-from pitotcal.core.airdata import mach_from_qc
-from pitotcal.core.checks import number
-from pitotcal.core.errors import FlightDataError
-from pitotcal.core.units import R_AIR_JKGK
+from .airdata import mach_from_qc
+from .checks import number
+from .errors import FlightDataError
+from .units import R_AIR_JKGK
 
 __all__ = [
     "EPSILON",

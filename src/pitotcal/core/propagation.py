@@ -1,8 +1,8 @@
 """The delta method: a derived quantity's standard deviation from the coefficients' covariance.
 
 One place for the propagation every 2-sigma band of a derived quantity uses (ΔV, Δp/q_c in
-`estimation.result`; Δp_p/q_cic, ΔM_pc, ΔH_pc in `estimation.static_source`; the planner's
-predicted band in `core.information`; the leg fit's ΔV in `estimation.legs_global`).
+`estimation.identification.result`; Δp_p/q_cic, ΔM_pc, ΔH_pc in `estimation.identification.static_source`; the planner's
+predicted band in `core.information`; the leg fit's ΔV in `estimation.legs.global_fit`).
 """
 
 import numpy as np

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pitotcal.io.atomic import atomic_open
+from .atomic import atomic_open
 
 __all__ = ["json_ready", "write_json"]
 

@@ -29,7 +29,7 @@ import numpy as np
 from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
-from pitotcal.io.atomic import atomic_open
+from .atomic import atomic_open
 
 __all__ = ["LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
@@ -172,7 +172,7 @@ def write_legs(legs, path, comments=()):
 
 def _not_text(path):
     """Why a file that is no UTF-8 is not read: UTF-16 named as such, else binary."""
-    from pitotcal.io.flight_checks import looks_utf16
+    from .flight_checks import looks_utf16
 
     with open(path, "rb") as f:
         head = f.read(4096)

@@ -10,7 +10,7 @@ https://docs.qgroundcontrol.com/master/en/qgc-dev-guide/file_formats/plan.html (
 import json
 from dataclasses import dataclass
 
-from pitotcal.io.atomic import atomic_open
+from .atomic import atomic_open
 
 __all__ = ["FRAME_GLOBAL", "FRAME_GLOBAL_RELATIVE_ALT", "FRAME_MISSION", "MAV_CMD",
            "MissionItem", "write_qgc_plan", "write_qgc_wpl"]

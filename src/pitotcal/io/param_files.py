@@ -15,7 +15,7 @@ CSV written by `pitotcal convert`, from its ``# autopilot_...`` comment lines.
 from pathlib import Path
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.io.atomic import atomic_open
+from .atomic import atomic_open
 
 __all__ = ["QGC_REAL32", "read_flight_and_parameters", "read_qgc_params",
            "write_ardupilot_params", "write_qgc_params"]

@@ -9,9 +9,9 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.plan import PLAN_COLUMNS, PLAN_RANGES, Plan
-from pitotcal.io.atomic import atomic_open
-from pitotcal.io.flight_checks import looks_utf16
-from pitotcal.io.jsonfile import json_ready
+from .atomic import atomic_open
+from .flight_checks import looks_utf16
+from .jsonfile import json_ready
 
 __all__ = ["read_plan", "write_plan"]
 

@@ -1,0 +1,1 @@
+"""Identification: the output-error problem, its residual and unknowns, `identify`, and its result."""

@@ -1,0 +1,217 @@
+"""Static-source products of a compressible calibration (issue 9, item 3).
+
+The "all error in the static source" reduction of USAF TPS / NTPS practice: the pitot's total
+pressure is exact, so the fitted pressure error is the static-source error,
+
+    Δp_p = p_s,ind − p_s = q_c − q_ci,     Δp_p / q_cic = f / (1 − f)   (q_cic = q_ci),
+
+and at each instrument-corrected indicated airspeed V_ic (standard CAS of q_ci) follow
+
+    M_ic  = M(q_ci, p_s,ind)          indicated Mach (`pitotcal.core.airdata.mach_from_qc`)
+    ΔM_pc = M(q_c, p_s) − M_ic        Mach position-error correction
+    ΔH_pc = H(p_s) − H(p_s,ind)       altimeter correction (`altimeter_correction_m`)
+
+at the flight's median indicated pressure altitude (the median of the static source's
+`ps_pa`). Their 2-sigma bands propagate the coefficients' covariance by the same central
+differences as the ΔV band (`estimation.propagation`).
+
+With an independent reference static pressure (`ps_ref_pa`), nothing is assumed: the static
+error is measured, Δp_p = p_s,ind − p_s,ref, and fitted by the same structure,
+Δp_p / q_c = f(q_ci; k_s) (`static_error_fit`, least squares with the colored-residual
+covariance); the total-pressure error is the rest, δp_T = p_T,ind − p_T = Δp_p − (q_c − q_ci).
+ΔM_pc and ΔH_pc then use the measured static error, and the rows add δp_T / q_cic.
+"""
+
+import numpy as np
+
+from pitotcal.core import airdata
+from pitotcal.core.models import get_model, qc_from_qci_pa
+from pitotcal.core.propagation import band, gradient
+from pitotcal.core.units import kt_to_mps, m_to_ft
+
+__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "plot_altimeter_correction",
+           "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",
+           "static_source_products", "static_statement", "static_table_lines"]
+
+ASSUMED_STATIC = ("all pressure error in the static source: total pressure exact, "
+                  "dp_p = q_c - q_ci = p_s,ind - p_s")
+MEASURED_STATIC = ("static-source error measured against the reference static pressure "
+                   "ps_ref_pa (dp_p = ps_pa - ps_ref_pa, fitted as dp_p/q_c = f(q_ci; k_static)); "
+                   "total-pressure error dp_T = dp_p - (q_c - q_ci); q_c predicted from ps_ref_pa")
+
+
+def pressure_altitude_ic_m(result):
+    """The flight's median indicated pressure altitude H_ic, m (None without `ps_pa`)."""
+    if result.ps_pa is None:
+        return None
+    return float(airdata.pressure_altitude_m(np.median(result.ps_pa)))
+
+
+def static_error_fit(result):
+    """(k_static, covariance) of the measured static error Δp_p = ps_pa − ps_ref_pa.
+
+    Δp_p = q_c f(q_ci; k_static) with q_c = q_ci / (1 − f(q_ci; k)) from the calibration; every
+    registered structure is linear in its coefficients, so one least-squares solve; the
+    covariance is the colored-residual one (`estimation.uncertainty.covariance`).
+    """
+    from ..uncertainty.covariance import colored_covariance
+    from .residual import ratio_columns
+
+    model = get_model(result.model)
+    qci = np.asarray(result.qci_pa, dtype=float)
+    qc = qc_from_qci_pa(model, result.coefficients, qci)
+    dp = np.asarray(result.ps_pa, dtype=float) - np.asarray(result.ps_ref_pa, dtype=float)
+    zero = np.zeros(len(model.params))
+    design = np.column_stack(ratio_columns(model, zero, qci)) * qc[:, None]
+    k_static = np.linalg.lstsq(design, dp - qc * model(zero, qci), rcond=None)[0]
+    residuals = dp - qc * model(k_static, qci)
+    return k_static, colored_covariance(design, residuals).covariance
+
+
+def _products(model, kk, vi_kt, ps_ind_pa, n_k):
+    """(Δp_p/q_cic, M_ic, ΔM_pc, ΔH_pc m, δp_T/q_cic) at V_ic = `vi_kt`.
+
+    kk holds the calibration's coefficients k, then (with a reference) k_static; without one
+    the static error is the total one and δp_T is zero.
+    """
+    k, k_static = kk[:n_k], kk[n_k:]
+    qci = airdata.qc_from_cas_pa(kt_to_mps(np.asarray(vi_kt, dtype=float)))
+    qc = qc_from_qci_pa(model, k, qci)
+    dp = qc - qci if k_static.size == 0 else qc * model(k_static, qci)
+    mach_i = airdata.mach_from_qc(qci, ps_ind_pa)
+    dmach = airdata.mach_from_qc(qc, ps_ind_pa - dp) - mach_i
+    h_ic = airdata.pressure_altitude_m(ps_ind_pa)
+    return (dp / qci, mach_i, dmach, airdata.altimeter_correction_m(dp, h_ic),
+            (dp - (qc - qci)) / qci)
+
+
+def static_source_products(result, vi_kt, plain=False):
+    """Static-source position errors at indicated airspeeds `vi_kt` (V_ic, kt).
+
+    Parameters
+    ----------
+    result : IdentificationResult
+        A compressible result (with `ps_pa`).
+    vi_kt : array_like
+        Instrument-corrected indicated airspeeds V_ic, kt.
+    plain : bool
+        2-sigma from the plain Hessian covariance instead of the colored-residual one.
+
+    Returns
+    -------
+    dict of ndarray
+        dpp_qcic, dpp_qcic_2sigma (Δp_p/q_cic), mach_i, dmach, dmach_2sigma, dh_ft,
+        dh_2sigma_ft; with a reference static pressure also dpt_qcic, dpt_qcic_2sigma
+        (δp_T/q_cic) and k_static, k_static_std; and pressure_altitude_ic_ft, the altitude
+        ΔH_pc is for.
+    """
+    model = get_model(result.model)
+    n_k = len(model.params)
+    kk, cov = result.coefficients, result._coef_cov(plain)
+    reference = result.ps_ref_pa is not None
+    if reference:
+        k_static, cov_static = static_error_fit(result)
+        kk = np.concatenate([kk, k_static])
+        cov = np.block([[cov, np.zeros((n_k, n_k))], [np.zeros((n_k, n_k)), cov_static]])
+    ps_ind = float(np.median(result.ps_pa))
+    values = _products(model, kk, vi_kt, ps_ind, n_k)
+    bands = [2.0 * band(gradient(lambda x, j=j: _products(model, x, vi_kt, ps_ind, n_k)[j],
+                                 kk), cov) for j in (0, 2, 3, 4)]
+    out = {"dpp_qcic": values[0], "dpp_qcic_2sigma": bands[0], "mach_i": values[1],
+           "dmach": values[2], "dmach_2sigma": bands[1], "dh_ft": m_to_ft(values[3]),
+           "dh_2sigma_ft": m_to_ft(bands[2]),
+           "pressure_altitude_ic_ft": float(m_to_ft(airdata.pressure_altitude_m(ps_ind)))}
+    if reference:
+        out.update(dpt_qcic=values[4], dpt_qcic_2sigma=bands[3], k_static=kk[n_k:],
+                   k_static_std=np.sqrt(np.diag(cov[n_k:, n_k:])))
+    return out
+
+
+def plot_static_error(ax, result, implied_ratio, vi_range_kt):
+    """Δp_p/q_cic vs M_ic with its 2σ band, and each sample's ratio from the residuals.
+
+    `implied_ratio` is the per-sample Δp/q_c (`estimation.reporting.view`); Δp_p/q_cic = g / (1 - g).
+    `vi_range_kt` the (lowest, highest) V_ic flown.
+    """
+    qci = np.asarray(result.qci_pa, dtype=float)
+    g = np.asarray(implied_ratio, dtype=float)
+    mach = airdata.mach_from_qc(qci, np.asarray(result.ps_pa, dtype=float))
+    pick = np.arange(0, qci.size, max(1, qci.size // 4000))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if result.ps_ref_pa is None:
+            points, label = g / (1.0 - g), "per sample (from residuals)"
+        else:
+            points = (np.asarray(result.ps_pa) - np.asarray(result.ps_ref_pa)) / qci
+            label = "per sample (ps_pa − ps_ref_pa)"
+        ax.plot(mach[pick], points[pick], ".", color="0.6", ms=2, alpha=0.3,
+                rasterized=True, label=label)
+    grid = static_source_products(result, np.linspace(*vi_range_kt, 100))
+    ratio, band = grid["dpp_qcic"], grid["dpp_qcic_2sigma"]
+    ax.fill_between(grid["mach_i"], ratio - band, ratio + band, color="tab:red", alpha=0.3,
+                    label="2σ")
+    ax.plot(grid["mach_i"], ratio, color="tab:red", lw=2, label="Δp_p / q_cic")
+    finite = points[np.isfinite(points)]
+    if finite.size:     # zoom on the curve, keep the cloud's bulk
+        p5, p95 = np.percentile(finite, [5, 95])
+        span = max(p95 - p5, 4 * float(np.max(band)), 1e-4)
+        mid = 0.5 * (float(np.min(ratio)) + float(np.max(ratio)))
+        ax.set_ylim(mid - span, mid + span)
+    kind = "all error assumed static" if result.ps_ref_pa is None else "measured: ps_ref_pa"
+    ax.set(xlabel="indicated Mach M_ic", ylabel="Δp_p / q_cic",
+           title=f"Static-source error ({kind})")
+    ax.legend(fontsize=8, loc="best")
+
+
+def plot_altimeter_correction(ax, result, vi_range_kt):
+    """ΔH_pc vs V_ic with its 2σ band, at the flight's median pressure altitude."""
+    vi = np.linspace(*vi_range_kt, 100)
+    grid = static_source_products(result, vi)
+    dh, band = grid["dh_ft"], grid["dh_2sigma_ft"]
+    ax.fill_between(vi, dh - band, dh + band, color="tab:green", alpha=0.3, label="2σ")
+    ax.plot(vi, dh, color="tab:green", lw=2, label="ΔH_pc = H_c − H_ic")
+    ax.set(xlabel="indicated airspeed V_ic (kt)", ylabel="ΔH_pc (ft)",
+           title=f"Altimeter correction at {grid['pressure_altitude_ic_ft']:.0f} ft "
+                 "pressure altitude")
+    ax.legend(fontsize=8, loc="best")
+
+
+# --- summary lines (estimation.reporting.view) --------------------------------------------
+
+def static_statement(result):
+    """(what was assumed or measured, the static-error fit or None) of a compressible result."""
+    if result.ps_ref_pa is None:
+        return ASSUMED_STATIC, None
+    k_static, cov = static_error_fit(result)
+    names = get_model(result.model).params
+    return MEASURED_STATIC, {name: {"value": float(v), "std": float(np.sqrt(c))}
+                             for name, v, c in zip(names, k_static, np.diag(cov))}
+
+
+def air_data_lines(result):
+    """The compressible summary's statement of what was computed and assumed."""
+    return [
+        ("Air data: compressible (isentropic q_c from V_t, the static port's p_s and T_s); "
+         "KIAS = V_ic and KCAS = V_c by the standard CAS law, ΔV = ΔV_pc."),
+        (f"{'Assumed' if result.ps_ref_pa is None else 'Measured'}: "
+         f"{static_statement(result)[0]}."),
+        "",
+    ]
+
+
+def static_table_lines(result, table):
+    """Static-source position error per row: Δp_p/q_cic, M_ic, ΔM_pc, ΔH_pc with 2σ."""
+    h_ic = pressure_altitude_ic_m(result)
+    lines = [
+        "",
+        (f"Static-source position error (altimeter correction at the flight's median pressure "
+         f"altitude {m_to_ft(h_ic):.0f} ft):"),
+        (f"  {'KIAS':>7}{'M_ic':>8}{'Δp_p/q_cic':>12}{'±2σ':>9}{'ΔM_pc':>9}{'±2σ':>9}"
+         f"{'ΔH_pc ft':>10}{'±2σ':>7}"),
+    ]
+    for row in table:
+        lines.append(f"  {row['vi_kt']:7.1f}{row['mach_i']:8.4f}{row['dpp_qcic']:+12.4f}"
+                     f"{row['dpp_qcic_2sigma']:9.4f}{row['dmach']:+9.4f}"
+                     f"{row['dmach_2sigma']:9.5f}{row['dh_ft']:+10.1f}{row['dh_2sigma_ft']:7.1f}"
+                     + (f"   δp_T/q_cic {row['dpt_qcic']:+.4f} ±{row['dpt_qcic_2sigma']:.4f}"
+                        if "dpt_qcic" in row else ""))
+    return lines

@@ -1,0 +1,221 @@
+"""The airspeed parameter an autopilot should load, from a calibration flight (issue 10).
+
+Derivation. Both autopilots turn the sensor's differential pressure Δp (offset removed; the
+q_ci pitotcal reads from the log, ArduPilot ``ARSP.DiffPress``, PX4 ``differential_pressure``)
+into an airspeed with one scale, and the calibration says which airspeed that pressure means:
+q_c = q_ci / (1 − f(q_ci)) and V_c = CAS law of q_c.
+
+- ArduPilot: EAS = sqrt(ARSPD_RATIO · Δp) (incompressible convention). It is right when
+  ratio · q_ci = V_c², so ratio = V_c(q_c)² / q_ci; with the incompressible V_c² = 2 q_c / ρ₀
+  and the constant model f = k1 this is ratio = 2 / (ρ₀ (1 − k1)). The log's current ratio
+  cancels: ArduPilot logs Δp before applying it (a log with only ``ARSP.Airspeed`` is turned
+  back into Δp = EAS² / ratio by the reader), so the new ratio is the current one times
+  V_c² / EAS², reported as that factor beside the current value.
+- PX4: CAS = ASPD_SCALE_1 · IAS with IAS = sqrt(2 Δp / ρ₀), so scale = V_c / IAS
+  = 1 / sqrt(1 − k1) for the constant model.
+
+Both use the best constant model (one scale over the flown range). With the compressible air
+data of a result whose ``air_data`` is "compressible", V_c is the isentropic CAS law and the
+ratio is evaluated at the median q_ci flown (it then drifts by ~(V/a₀)²/4 across speeds,
+0.1 % at 50 kt). The 2σ follows from k1's 2σ (delta method).
+
+Refusals (a `PitotcalError`, exit 2, one line): the track turned through less than
+`MIN_TRACK_SPREAD_DEG`; the constant-model fit did not converge; the inverse or linear model departs from the constant one by more than
+its own 2σ somewhere in the flown range (one scale cannot represent the error: the scale right
+at cruise is wrong near the stall); the 2σ of the new value is wider than `TOLERANCE` of it
+while the current value lies inside that band (the flight cannot improve on it).
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from pitotcal.core.errors import ObservabilityError, PitotcalError
+from pitotcal.core.propagation import band, gradient
+from pitotcal.core.units import RHO0_KGM3
+
+__all__ = ["MIN_TRACK_SPREAD_DEG", "TOLERANCE", "ParameterRecommendation", "recommend",
+           "write_parameter_file"]
+
+# A parameter is committed only after turning through three quarters of a circle: wind and
+# scale then separate with margin (identify itself needs only more than half a circle).
+MIN_TRACK_SPREAD_DEG = 270.0
+# Relative 2σ of the airspeed the new parameter gives above which a flight that cannot tell
+# the new value from the current one is refused: 1 % of airspeed (2 % of ARSPD_RATIO).
+TOLERANCE = 0.01
+PARAMETER = {"ArduPilot": "ARSPD_RATIO", "PX4": "ASPD_SCALE_1"}
+
+
+@dataclass(frozen=True)
+class ParameterRecommendation:
+    """A new airspeed parameter and why.
+
+    Attributes
+    ----------
+    autopilot : {"ArduPilot", "PX4"}
+    name : str
+        ``ARSPD_RATIO`` or ``ASPD_SCALE_1`` (``ASPD_SCALE`` on older PX4 logs that have it).
+    value, two_sigma : float
+        The recommended value and its 2σ.
+    current : float or None
+        The value the log was flown with.
+    k1, k1_two_sigma : float
+        The constant model's coefficient Δp/q_c and its 2σ.
+    qci_ref_pa : float
+        Median q_ci flown, where a compressible ratio is evaluated.
+    air_data : str
+    track_spread_deg : float
+    departures : dict
+        Model -> {max_departure_kt, two_sigma_kt, vi_kt}: the largest |ΔV_model − ΔV_constant|
+        over the flown range relative to the model's 2σ there.
+    notes : tuple of str
+    """
+
+    autopilot: str
+    name: str
+    value: float
+    two_sigma: float
+    current: float | None
+    k1: float
+    k1_two_sigma: float
+    qci_ref_pa: float
+    air_data: str
+    track_spread_deg: float
+    departures: dict = field(default_factory=dict)
+    notes: tuple = ()
+
+    def comments(self):
+        """The comment lines of the parameter file."""
+        cur = "not in the log" if self.current is None else f"{self.current:.6g}"
+        lines = [f"pitotcal: {self.name} = {self.value:.6f} +/- {self.two_sigma:.6f} (2 sigma)",
+                 (f"current value {cur}; constant model k1 = {self.k1:.5f} +/- "
+                  f"{self.k1_two_sigma:.5f} (2 sigma), air data {self.air_data}"),
+                 f"track turned through {self.track_spread_deg:.0f} deg"]
+        if self.current:
+            lines.append(f"new / current = {self.value / self.current:.5f}")
+        return lines + list(self.notes)
+
+
+def recommend(flight, autopilot, current=None, *, name=None, air="compressible",
+              **noise):
+    """The airspeed parameter for `autopilot` from `flight`, or a refusal.
+
+    Parameters
+    ----------
+    flight : Flight
+    autopilot : {"ArduPilot", "PX4"}
+    current : float, optional
+        The value the log was flown with.
+    name : str, optional
+        Parameter name (default ``ARSPD_RATIO`` / ``ASPD_SCALE_1``).
+    air : {"compressible", "incompressible"}
+        Passed to `identify` (a flight without static pressure is fitted incompressible).
+    **noise
+        `identify`'s noise keywords, passed on: ``gps_noise_std_mps``, ``gps_error_sigma_mps``,
+        ``gps_error_tau_s``.
+
+    Returns
+    -------
+    ParameterRecommendation
+
+    Raises
+    ------
+    PitotcalError
+        Exit 2: the track did not turn enough, one scale cannot represent the error, or the
+        bounds are too wide to improve on the current value (module docstring).
+    """
+    from ..identification.identify import identify, track_spread_deg
+
+    if autopilot not in PARAMETER:
+        raise PitotcalError(f"no airspeed parameter for autopilot {autopilot!r}: the flight "
+                            "must come from an ArduPilot or PX4 log (or its converted CSV)")
+    name = name or PARAMETER[autopilot]
+    spread = track_spread_deg(flight.gps_vn_mps, flight.gps_ve_mps)
+    if spread < MIN_TRACK_SPREAD_DEG:
+        raise PitotcalError(f"no parameter recommended: the track turned through only "
+                            f"{spread:.0f} deg (need {MIN_TRACK_SPREAD_DEG:.0f} before "
+                            f"committing {name}); fly a full circle")
+    const = identify(flight, model="constant", air=air, **noise)
+    if not const.success:
+        raise PitotcalError(f"no parameter recommended: the constant-model fit did not "
+                            f"converge ({const.message})")
+    departures, notes = _departures(flight, const, noise, air)
+    for model, d in departures.items():
+        if d["max_departure_kt"] > d["two_sigma_kt"]:
+            raise PitotcalError(
+                f"no parameter recommended: the {model} model departs from one scale by "
+                f"{d['max_departure_kt']:.2f} kt at {d['vi_kt']:.0f} KIAS (its 2 sigma "
+                f"{d['two_sigma_kt']:.2f} kt): a single {name} cannot represent the error "
+                "over the flown range")
+    air = getattr(const, "air_data", None) or "incompressible"
+    qref = float(np.median(const.qci_pa))
+    k1, k1_sd = const.value("k1"), const.stddev("k1")
+    value = _parameter(autopilot, k1, qref, air)
+    grad = gradient(lambda k: _parameter(autopilot, k[0], qref, air), [k1])
+    two_sigma = 2.0 * float(band(grad, np.array([[k1_sd ** 2]])))
+    _check_bounds(name, value, two_sigma, current, autopilot)
+    if current is not None and abs(value - current) <= two_sigma:
+        notes.append("the current value is inside the 2 sigma band: the change is not "
+                     "significant, keeping the current value is as good")
+    return ParameterRecommendation(autopilot, name, value, two_sigma, current, k1, 2 * k1_sd,
+                                   qref, air, spread, departures, tuple(notes))
+
+
+def _parameter(autopilot, k1, qci_pa, air_data):
+    """ARSPD_RATIO = V_c² / q_ci, or ASPD_SCALE = V_c / IAS, at q_ci for the constant k1."""
+    qc = qci_pa / (1.0 - k1)
+    if air_data == "compressible":
+        from pitotcal.core.airdata import cas_from_qc_mps
+        vc_sq = float(cas_from_qc_mps(qc)) ** 2
+    else:
+        vc_sq = 2.0 * qc / RHO0_KGM3
+    if autopilot == "ArduPilot":
+        return vc_sq / qci_pa
+    return float(np.sqrt(vc_sq / (2.0 * qci_pa / RHO0_KGM3)))
+
+
+def _check_bounds(name, value, two_sigma, current, autopilot):
+    # the airspeed goes as the ratio's square root and as the scale itself
+    rel_airspeed = (0.5 if autopilot == "ArduPilot" else 1.0) * two_sigma / value
+    if rel_airspeed <= TOLERANCE:
+        return
+    if current is None or abs(value - current) <= two_sigma:
+        where = ("the log has no current value" if current is None
+                 else f"the current {current:.6g} lies inside it")
+        raise PitotcalError(
+            f"no parameter recommended: bounds too wide to improve on the current value: "
+            f"{name} = {value:.4f} +/- {two_sigma:.4f} (2 sigma, {100 * rel_airspeed:.1f} % "
+            f"of airspeed, need <= {100 * TOLERANCE:g} %) and {where}; fly longer or steadier")
+
+
+def _departures(flight, const, noise, air):
+    """How far the two-coefficient models depart from the constant one over the flown range."""
+    from ..identification.identify import identify
+
+    out, notes = {}, []
+    for model in ("inverse", "linear"):
+        try:
+            res = identify(flight, model=model, air=air, **noise)
+        except ObservabilityError as exc:
+            notes.append(f"{model} model not identifiable ({exc}); one scale not tested "
+                         "against it")
+            continue
+        rows = res.correction_table()
+        vi = np.array([r["vi_kt"] for r in rows])
+        dv_m = np.array([r["dv_kt"] for r in rows])
+        band = np.array([r["dv_2sigma_kt"] for r in rows])
+        dv_c, _ = const.delta_v_kt(vi)
+        excess = np.abs(dv_m - dv_c) - band
+        i = int(np.argmax(excess))
+        out[model] = {"max_departure_kt": float(abs(dv_m[i] - dv_c[i])),
+                      "two_sigma_kt": float(band[i]), "vi_kt": float(vi[i])}
+    return out, notes
+
+
+def write_parameter_file(rec, path):
+    """Write `rec` as the file its autopilot loads: ArduPilot a Mission Planner / MAVProxy
+    parameter file, PX4 a QGroundControl parameter file. Returns the path."""
+    from pitotcal.io.param_files import write_ardupilot_params, write_qgc_params
+
+    writer = write_ardupilot_params if rec.autopilot == "ArduPilot" else write_qgc_params
+    return writer(path, rec.name, rec.value, rec.comments())

@@ -1,0 +1,399 @@
+"""The calibration report: one self-contained HTML file from a result JSON (issue 10).
+
+`build_report` gathers what the template shows (title block, test conditions, method, the
+correction tables, figures as base64 PNG, warnings, compliance, legs, provenance, signatures);
+`render_html` fills the jinja2 template `templates/report.html.j2` (package data). Missing
+additions of newer results are said, not hidden: without `dv_U_kt` the tables and the verdict
+say that only the statistical 2σ is included; without `dh_ft` the altimeter check is not
+demonstrated.
+"""
+
+import base64
+import datetime
+import hashlib
+import math
+import tomllib
+import warnings
+from pathlib import Path
+
+from pitotcal.core.errors import PitotcalError
+from pitotcal.io.atomic import atomic_open, atomic_path
+
+from . import compliance as comp
+
+__all__ = ["AIRCRAFT_FIELDS", "build_report", "make_report", "read_aircraft", "read_result",
+           "render_html", "sha256", "write_pdf"]
+
+# The title block: (TOML table, key, label), in the order shown.
+AIRCRAFT_FIELDS = (
+    ("aircraft", "type", "Aircraft"), ("aircraft", "registration", "Registration"),
+    ("aircraft", "serial", "Serial number"), ("aircraft", "configuration", "Configuration"),
+    ("aircraft", "weight", "Weight"), ("aircraft", "cg", "Centre of gravity"),
+    ("aircraft", "pitot_static", "Pitot-static installation"),
+    ("test", "date", "Test date"), ("test", "location", "Location"),
+    ("test", "pilot", "Pilot"), ("test", "engineer", "Flight-test engineer"),
+    ("test", "notes", "Notes"),
+)
+
+
+def sha256(path):
+    """SHA-256 hex digest of a file."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def read_aircraft(path):
+    """The title-block rows [(label, text)] of an aircraft TOML (`AIRCRAFT_FIELDS`, then any
+    other key of its tables); PitotcalError naming the file and line when it is not TOML."""
+    try:
+        with open(path, "rb") as f:
+            doc = tomllib.load(f)
+    except tomllib.TOMLDecodeError as exc:
+        raise PitotcalError(f"--aircraft {path}: not valid TOML ({exc})") from None
+    rows, seen = [], set()
+    for table, key, label in AIRCRAFT_FIELDS:
+        value = doc.get(table, {}).get(key) if isinstance(doc.get(table), dict) else None
+        if value is not None:
+            rows.append((label, str(value)))
+            seen.add((table, key))
+    for table, content in doc.items():
+        items = content.items() if isinstance(content, dict) else [(None, content)]
+        for key, value in items:
+            if (table, key) not in seen:
+                rows.append((f"{table}.{key}" if key else table, str(value)))
+    return rows
+
+
+def _png(data):
+    return None if data is None else base64.b64encode(data).decode("ascii")
+
+
+def _fmt(x, spec):
+    return "—" if x is None or (isinstance(x, float) and not math.isfinite(x)) else format(x, spec)
+
+
+def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
+                 speed_range_kt=None, inputs=(), options=None, ident=None):
+    """Everything the report template shows, as a plain dict.
+
+    Parameters
+    ----------
+    result : dict
+        The result JSON (docs/interfaces.md §3, with the §9 additions when present).
+    flight : Flight, optional
+        The flight the result came from: test conditions, and with `ident` the figures of the fit.
+    aircraft_rows : sequence of (label, text)
+        The title block (`read_aircraft`).
+    regulation, speed_range_kt
+        Passed to `compliance.assess`.
+    inputs : sequence of (role, path)
+        Files whose SHA-256 the provenance lists.
+    options : dict, optional
+        Every option the report was made with (provenance).
+    ident : IdentificationResult, optional
+        The fit re-run on `flight` for the figures that need samples.
+
+    Returns
+    -------
+    dict
+        Keys of the template (module docstring) plus ``compliance`` (the JSON block).
+    """
+    from pitotcal import __version__
+
+    from . import figures as figs
+
+    block = comp.assess(result, regulation, speed_range_kt)
+    rows = result.get("airspeed_correction") or []
+    has_u = bool(rows) and all(r.get("dv_U_kt") is not None for r in rows)
+    warnings = list(result.get("warnings", []))
+    if not result.get("converged", True):
+        warnings.insert(0, "the solver did not converge: the numbers are not a calibration")
+    if not has_u:
+        warnings.append("the result has no expanded uncertainty U (dv_U_kt): tables and "
+                        "verdict include only the statistical 2σ")
+    figures = [("Airspeed correction", _png(figs.correction_png(result, block)))]
+    alt = figs.altimeter_png(result, block)
+    if alt is not None:
+        figures.append(("Altimeter correction", _png(alt)))
+    if ident is not None and flight is not None:
+        if "points" not in result:      # a legs result is another method: not comparable
+            warnings += _reproduces(result, ident)
+        figures.append(("Calibration (paper Figs. 7-8 style), with the residual time history",
+                        _png(figs.calibration_png(ident))))
+        figures.append(("Ground track and residual distribution", _png(figs.track_png(flight,
+                                                                                      ident))))
+    now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
+    return {
+        "title_rows": list(aircraft_rows),
+        "conditions": _conditions(result, flight),
+        "method": _method(result),
+        "correction_rows": [_correction_row(r) for r in rows],
+        "has_u": has_u,
+        "budget": result.get("uncertainty_budget") or [],
+        "altimeter_rows": [r for r in rows if r.get("dh_ft") is not None],
+        "mach_rows": _mach_rows(result),
+        "figures": figures,
+        "warnings": warnings,
+        "compliance": block,
+        "legs": _legs(result),
+        "provenance": {"version": __version__, "date": now, "options": dict(options or {}),
+                       "inputs": [(role, str(p), sha256(p)) for role, p in inputs]},
+        "fmt": _fmt,
+    }
+
+
+def _reproduces(result, ident):
+    """A warning when the fit re-run on the given flight is not the result's."""
+    out = []
+    for name, entry in (result.get("parameters") or {}).items():
+        if name not in ident.param_names or not isinstance(entry, dict):
+            continue
+        value, std = entry.get("value"), entry.get("std")
+        if value is None or not std:
+            continue
+        if abs(ident.value(name) - value) > 0.1 * std:
+            out.append(f"the flight given does not reproduce the result ({name} "
+                       f"{ident.value(name):.5g} vs {value:.5g}): the figures of the fit are "
+                       "of the flight as read, check window, OAT and file")
+            break
+    return out
+
+
+def _param(result, name, scale=1.0):
+    entry = (result.get("parameters") or {}).get(name) or {}
+    value, std = entry.get("value"), entry.get("std")
+    return (None if value is None else value * scale,
+            None if std is None else 2 * std * scale)
+
+
+def _conditions(result, flight):
+    """(label, text) rows: wind with 2σ, turbulence indication, samples, altitude, time."""
+    from pitotcal.core.units import m_to_ft, mps_to_kt
+
+    spd, spd2 = _param(result, "wind_speed_mps", mps_to_kt(1.0))
+    frm, frm2 = _param(result, "wind_from_deg")
+    rows = [("Wind (identified)", (f"{_fmt(spd, '.1f')} ± {_fmt(spd2, '.1f')} kt from "
+                                  f"{_fmt(frm, '.0f')}° ± {_fmt(frm2, '.1f')}° true (2σ)")),
+            ("Samples used", (f"{result.get('n_samples', '—')} "
+                             f"({result.get('n_dropped', 0)} dropped by the reader)")),
+            ("Residual RMS", f"{_fmt(result.get('noise_std_pa'), '.2f')} Pa"),
+            ("Turbulence indication", _turbulence(result))]
+    if flight is not None:
+        t = flight.time_s
+        rows.append(("Flight time", f"{t[-1] - t[0]:.0f} s ({t[0]:.1f}–{t[-1]:.1f} s)"))
+        if flight.alt_m is not None and (alt := flight.alt_m[~_isnan(flight.alt_m)]).size:
+            rows.append(("Altitude", f"{m_to_ft(alt.min()):.0f}–{m_to_ft(alt.max()):.0f} ft"))
+        rho = flight.rho_kgm3
+        rows.append(("Air density", f"{rho.min():.4f}–{rho.max():.4f} kg/m³"))
+        for key in ("oat_source", "temperature_source", "autopilot", "firmware"):
+            if key in flight.meta:
+                rows.append((key.replace("_", " ").capitalize(), str(flight.meta[key])))
+    rows.append(("Result source", str(result.get("source", "—"))))
+    return rows
+
+
+def _isnan(a):
+    import numpy as np
+    return np.isnan(np.asarray(a, dtype=float))
+
+
+def _turbulence(result):
+    """How far the colored-residual 2σ exceeds the plain one: ~1 in still air, larger with
+    turbulence or wind change (estimation.uncertainty.covariance)."""
+    k1 = (result.get("parameters") or {}).get("k1") or {}
+    std, plain = k1.get("std"), k1.get("std_plain")
+    if not std or not plain:
+        return "—"
+    ratio = std / plain
+    word = "calm" if ratio < 1.5 else "light" if ratio < 4 else "moderate or more"
+    return (f"{word}: the corrected k1 2σ is {ratio:.1f}× the plain Hessian one "
+            "(correlated residuals)")
+
+
+def _method(result):
+    params = result.get("parameters") or {}
+    coefs = ", ".join(f"{n} = {p['value']:.5g} ± {2 * p['std']:.2g}" for n, p in params.items()
+                      if isinstance(p, dict) and not n.startswith("wind")
+                      and p.get("value") is not None and p.get("std") is not None)
+    air = result.get("air_data")
+    return [
+        ("Method", ("global output-error identification from GPS (NASA AirSTAR); pressure "
+                   "error and wind estimated together, the track turning through the wind")),
+        ("Pressure-error model", f"{result.get('model', '—')}: {result.get('formula', '')}"),
+        ("Coefficients (2σ)", coefs or "—"),
+        ("Air data", air if air else "incompressible (the result records no air-data mode)"),
+        ("Static vs total error", ("the method measures the total pressure error Δp_p of the "
+                                  "pitot-static pair and does not separate static-source from "
+                                  "total-pressure error; ΔH_pc is shown only when the result "
+                                  "carries it (dh_ft), under the result's own assumption")),
+        ("Uncertainty", "2σ: statistical, corrected for coloured residuals; U: expanded "
+                        "uncertainty (k = 2) of the result's uncertainty budget"
+                        if result.get("uncertainty_budget") else
+                        "2σ: statistical, corrected for coloured residuals (no budget in the "
+                        "result: systematic contributions not included)"),
+    ]
+
+
+def _correction_row(r):
+    return {"vi": r.get("vi_kt"), "dv": r.get("dv_kt"), "two": r.get("dv_2sigma_kt"),
+            "u": r.get("dv_U_kt"), "vc": r.get("vc_kt")}
+
+
+def _mach_rows(result):
+    """Δp_p/q_cic vs M_ic from each row's V_i and V_c, when the result has mach_i."""
+    rows = [r for r in result.get("airspeed_correction") or [] if r.get("mach_i") is not None]
+    if not rows:
+        return []
+    if result.get("air_data") == "compressible":
+        from pitotcal.core.airdata import qc_from_cas_pa
+    else:
+        from pitotcal.core.units import incompressible_qc_pa as qc_from_cas_pa
+    from pitotcal.core.units import kt_to_mps
+
+    out = []
+    for r in rows:
+        ratio = r.get("dpp_qcic")       # the identification's own Δp_p/q_cic, when it gave it
+        if ratio is None:
+            qci = float(qc_from_cas_pa(kt_to_mps(r["vi_kt"])))
+            ratio = (float(qc_from_cas_pa(kt_to_mps(r["vc_kt"]))) - qci) / qci
+        out.append({"mach": r["mach_i"], "dmach": r.get("dmach"), "ratio": ratio,
+                    "vi": r["vi_kt"]})
+    return out
+
+
+def _legs(result):
+    points = result.get("points")
+    if not isinstance(points, list) or not points:
+        return None
+    keys = [k for k in ("point", "ias_kt", "tas_kt", "tas_2sigma_kt", "wind_speed_kt",
+                        "wind_from_deg", "dv_kt", "dv_2sigma_kt", "method")
+            if any(k in p for p in points)]
+    glob = result.get("global")
+    return {"keys": keys, "points": points,
+            "global": sorted(glob.items()) if isinstance(glob, dict) else []}
+
+
+def render_html(context):
+    """The report as one HTML string (jinja2, autoescaped; template from the package)."""
+    import jinja2
+
+    env = jinja2.Environment(
+        loader=jinja2.PackageLoader("pitotcal.estimation.reporting", "templates"),
+        autoescape=True, undefined=jinja2.StrictUndefined, trim_blocks=True,
+        lstrip_blocks=True)
+    return env.get_template("report.html.j2").render(**context)
+
+
+def write_pdf(html_path, pdf_path):
+    """Print the HTML report to PDF with headless Chromium (``--print-to-pdf``).
+
+    Raises
+    ------
+    PitotcalError
+        No Chromium on PATH, or it failed.
+    """
+    import shutil
+    import subprocess
+
+    browser = next((shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome")
+                    if shutil.which(b)), None)
+    if browser is None:
+        raise PitotcalError("--pdf needs Chromium on PATH (Debian: apt-get install chromium)")
+    # printed to a temporary file beside it, renamed when whole (pitotcal.io.atomic)
+    with atomic_path(pdf_path) as tmp:
+        cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+               f"--print-to-pdf={Path(tmp).resolve()}", Path(html_path).resolve().as_uri()]
+        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
+        if proc.returncode != 0 or not Path(tmp).stat().st_size:
+            raise PitotcalError(f"--pdf: Chromium failed ({proc.stderr.strip()[-200:]})")
+    return pdf_path
+
+
+def read_result(path):
+    """The result JSON as a dict; PitotcalError naming the file when it is not one."""
+    import json
+
+    try:
+        with open(path) as f:
+            doc = json.load(f)
+    except json.JSONDecodeError as exc:
+        raise PitotcalError(f"{path}: not a JSON file ({exc})") from None
+    except UnicodeDecodeError:
+        raise PitotcalError(f"{path}: not a JSON file (binary content)") from None
+    if isinstance(doc, dict) and not doc.get("airspeed_correction"):
+        from ..legs.report import legs_as_result
+
+        doc = legs_as_result(doc)
+    if not isinstance(doc, dict) or not doc.get("airspeed_correction"):
+        raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` or "
+                            "`pitotcal legs --json` (no airspeed_correction table)")
+    return doc
+
+
+
+def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
+                aircraft_path=None,
+                regulation="23.1323", speed_range_kt=None, json_path=None, pdf_path=None,
+                options=None):
+    """Read the inputs, write the HTML report (and the JSON / PDF when asked).
+
+    `flight_options` are the reading identify used: start_s, end_s, oat_k (`read_flight`),
+    temp_recovery, rh_pct (`core.moist_air.with_static_air`); those not given (None) come from
+    the result's `reading`. The re-fit takes the result's model, air-data mode (`air_data`;
+    "incompressible" when it records none), GPS noise and stated GPS error (`gps_error`).
+
+    Returns
+    -------
+    dict
+        ``compliance`` (the JSON block) and ``written`` (the paths written, in order).
+    """
+    result = read_result(result_path)
+    inputs = [("Result JSON", result_path)]
+    flight = ident = None
+    if flight_path is not None:
+        from pitotcal.core.moist_air import with_static_air
+        from pitotcal.io import read_flight
+
+        from ..identification.identify import identify
+
+        # what identify recorded ("reading"), overridden by what the report was told
+        opts = {k: v for src in (result.get("reading") or {}, flight_options or {})
+                for k, v in src.items() if v is not None}
+        flight = read_flight(flight_path, opts.pop("start_s", None), opts.pop("end_s", None),
+                             oat_k=opts.pop("oat_k", None))
+        # identify's temperature and humidity reading, then its air-data mode: the same fit
+        flight = with_static_air(flight, **opts)
+        stated = result.get("gps_error") or {}
+        ident = identify(flight, model=result.get("model", "inverse"),
+                         air=result.get("air_data", "incompressible"),
+                         gps_noise_std_mps=result.get("gps_noise_std_mps"),
+                         gps_error_sigma_mps=stated.get("sigma_mps"),
+                         gps_error_tau_s=stated.get("tau_s"))
+        inputs.append(("Flight", flight_path))
+    rows = ()
+    if aircraft_path is not None:
+        rows = read_aircraft(aircraft_path)
+        inputs.append(("Aircraft file", aircraft_path))
+    context = build_report(result, flight=flight, aircraft_rows=rows, regulation=regulation,
+                           speed_range_kt=speed_range_kt, inputs=inputs, options=options,
+                           ident=ident)
+    html = render_html(context)
+    with atomic_open(html_path, "w", encoding="utf-8") as fh:
+        fh.write(html)
+    written = [html_path]
+    if json_path is not None:
+        from pitotcal.io.jsonfile import write_json
+
+        write_json(json_path, {**result, "warnings": context["warnings"],
+                               "compliance": context["compliance"]})
+        written.append(json_path)
+    if pdf_path is not None:
+        written.append(write_pdf(html_path, pdf_path))
+    # the report's own warnings (the result's were said when it was made), after the files
+    for message in context["warnings"]:
+        if message not in result.get("warnings", []):
+            warnings.warn(message, stacklevel=2)
+    return {"compliance": context["compliance"], "written": written}

@@ -1,0 +1,1 @@
+"""Robustness checks of an identification: plausibility gates and trimming, jumps, consistency over the flight."""

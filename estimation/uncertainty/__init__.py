@@ -1,0 +1,1 @@
+"""Uncertainty of an identification: the colored-residual covariance, the residual noise model, the GUM budget."""

@@ -1,0 +1,319 @@
+"""The uncertainty budget of the airspeed correction (GUM): statistical part plus Type B inputs.
+
+    u_c(V_i)² = (σ_stat)² + Σ_j u_j(V_i)²,      U = k u_c,  k = 2
+
+σ_stat is the estimate's own standard deviation (the colored-residual covariance:
+`dv_2sigma_kt` / 2). Each Type B input x_j (a quantity the fit takes as exact) has a standard
+uncertainty u(x_j) with a documented default the user can override (`BudgetInputs`); its
+contribution is found by re-solving: the flight is perturbed to x_j ± u(x_j), `identify`
+re-solved on each with the same model and GPS noise, and at each table speed
+
+    u_j(V_i) = sqrt((d₊² + d₋²) / 2),   d± = ΔV(V_i; x_j ± u) − ΔV(V_i; x_j)
+
+For an effect linear in x_j this is |∂ΔV/∂x_j| u, the GUM's first-order term; when the effect
+is not linear (the GPS latency is partly quadratic: a misalignment either way degrades the
+fit alike) it keeps the second-order part a central difference would cancel. The tests check
+each term against re-solves at half the step and against the bias the simulator injects.
+The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a counts a/√3):
+
+- oat: static air temperature, u = 1 K (a calibrated OAT probe ±1 K; the issue's figure); the
+  density ρ → ρ T/(T ± u) and the static temperature itself.
+- humidity: relative humidity, u = 5 %RH with a humidity channel or --rh-percent, else 58 %RH
+  (= 100/√3: dry air assumed while the truth is anywhere in 0-100 %, so the error is one-sided
+  and its RMS is the effect at 100/√3, not the 50/√3 of an estimate centred at 50 %); ρ
+  through the virtual temperature.
+- gps_velocity_bias: a constant GPS velocity error per axis, u = 0.05 m/s (u-blox M8/M9 speed
+  accuracy). A horizontal bias b is the wind's: V_g + b − W = V_g − (W − b), so the fitted wind
+  absorbs it exactly and ΔV does not move (the tests re-solve to show it); only the vertical
+  channel is re-solved.
+- gps_latency: the GPS velocity's age relative to the pressure, u = 0.05 s (a receiver's
+  latency known to within a navigation cycle); the GPS channels shifted in time.
+- probe_lever_arm: a probe at y = arm on the wing sees V_t − r·y in a turn at yaw rate r
+  (ω × r); u = |arm| (`--probe-arm-m`, default 0: the fit assumes the probe on the centre line);
+  q_ci → q_ci (1 ∓ r·arm / V_t)², r = ψ̇ cos φ from the air-relative heading rate, tan φ = V ψ̇/g.
+- qc_scale, qc_offset: the transducer's calibration, u = 0.1 % of reading and 1 Pa (a
+  calibrated flight-test transducer; a hobby MEMS sensor is 1 % and 5-10 Pa): ΔV_pc is the
+  position error only if the transducer's own error is known to this.
+"""
+
+import dataclasses
+import math
+import warnings
+
+import numpy as np
+
+from pitotcal.core import checks
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.moist_air import moist_density_kgm3
+from pitotcal.core.units import (
+    G0_MPS2,
+    ISA_T0_K,
+    R_AIR_JKGK,
+    isa_temperature_k,
+    wind_vector_mps,
+)
+
+__all__ = ["COVERAGE_K", "SOURCES", "Budget", "BudgetInputs", "uncertainty_budget"]
+
+COVERAGE_K = 2.0
+# (source name in the JSON, BudgetInputs field of its standard uncertainty, unit)
+SOURCES = (
+    ("oat", "u_oat_k", "K"),
+    ("humidity", "u_rh_pct", "%RH"),
+    ("gps_velocity_bias", "u_gps_velocity_mps", "m/s"),
+    ("gps_latency", "u_gps_latency_s", "s"),
+    ("probe_lever_arm", "probe_arm_m", "m"),
+    ("qc_scale", "u_qc_scale", "1"),
+    ("qc_offset", "u_qc_offset_pa", "Pa"),
+)
+RH_U_GIVEN_PCT = 5.0                       # a humidity channel's standard uncertainty
+RH_U_UNKNOWN_PCT = 100.0 / math.sqrt(3.0)  # dry assumed, truth anywhere in 0-100 %RH: RMS error
+
+
+@dataclasses.dataclass(frozen=True)
+class BudgetInputs:
+    """Standard uncertainties of the Type B inputs (module notes give each default's source).
+
+    `u_rh_pct` None: 5 %RH when the flight has a humidity, else 58 %RH (dry assumed).
+    """
+
+    u_oat_k: float = 1.0
+    u_rh_pct: float | None = None
+    u_gps_velocity_mps: float = 0.05
+    u_gps_latency_s: float = 0.05
+    probe_arm_m: float = 0.0
+    u_qc_scale: float = 0.001
+    u_qc_offset_pa: float = 1.0
+
+    def checked(self):
+        """A copy with every value checked (PitotcalError naming the field) and rh resolved."""
+        out = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if value is None:
+                out[f.name] = None
+            elif f.name == "probe_arm_m":
+                out[f.name] = checks.number(f.name, value, -50.0, 50.0)
+            else:
+                out[f.name] = checks.number(f.name, value, 0.0)
+        return BudgetInputs(**out)
+
+
+@dataclasses.dataclass(frozen=True)
+class Budget:
+    """The budget over the correction table's speeds.
+
+    Attributes
+    ----------
+    vi_kt : ndarray (m,)
+        Indicated airspeeds of the correction table, kt.
+    statistical_kt : ndarray (m,)
+        σ_stat = dv_2sigma_kt / 2, kt.
+    terms_kt : dict
+        Source name -> u_j at each speed, kt (`SOURCES` order).
+    inputs : dict
+        Source name -> (standard uncertainty of the input, unit).
+    warnings : tuple of str
+    """
+
+    vi_kt: np.ndarray
+    statistical_kt: np.ndarray
+    terms_kt: dict
+    inputs: dict
+    warnings: tuple = ()
+
+    @property
+    def combined_kt(self):
+        """u_c at each speed, kt."""
+        total = self.statistical_kt ** 2 + sum(t ** 2 for t in self.terms_kt.values())
+        return np.sqrt(total)
+
+    @property
+    def expanded_kt(self):
+        """U = k u_c, k = 2, at each speed, kt."""
+        return COVERAGE_K * self.combined_kt
+
+    def to_list(self):
+        """The JSON's `uncertainty_budget`: statistical first, each u_dv_kt its max over V_i."""
+        rows = [{"source": "statistical", "u_dv_kt": float(np.max(self.statistical_kt))}]
+        for name, u in self.terms_kt.items():
+            u_in, unit = self.inputs[name]
+            rows.append({"source": name, "u_dv_kt": float(np.max(u)), "u_input": u_in,
+                         "unit": unit})
+        return rows
+
+
+def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
+    """The GUM budget of `result`'s airspeed correction, by re-solving perturbed flights.
+
+    Parameters
+    ----------
+    flight : pitotcal.core.flight.Flight
+        The flight `result` was identified from (as passed to `identify`).
+    result : IdentificationResult
+    inputs : BudgetInputs, optional
+        Standard uncertainties of the Type B inputs; default `BudgetInputs()`.
+    **identify_kwargs
+        Passed on to `identify` for every re-solve (e.g. `air=`); the model is `result.model`
+        and the GPS noise `result.gps_noise_std_mps`, so only the perturbed input differs.
+
+    Returns
+    -------
+    Budget
+        Over the speeds of `result.correction_table()`.
+
+    Notes
+    -----
+    Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
+    vertical channel): at most 14, each reusing `identify`'s cached solver
+    (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
+    identify's estimate without the bounds and consistency checks the budget does not use.
+    """
+    from ..identification.identify import estimate
+
+    inputs = (inputs or BudgetInputs()).checked()
+    rows = result.correction_table()
+    vi = np.array([r["vi_kt"] for r in rows])
+    stat = np.array([r["dv_2sigma_kt"] for r in rows]) / 2.0
+    kwargs = {**identify_kwargs, "gps_noise_std_mps": result.gps_noise_std_mps,
+              "model": result.model}
+    u_rh = inputs.u_rh_pct
+    if u_rh is None:
+        u_rh = RH_U_GIVEN_PCT if flight.rh_pct is not None else RH_U_UNKNOWN_PCT
+    inputs = dataclasses.replace(inputs, u_rh_pct=u_rh)
+    notes = []
+
+    dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
+
+    def sensitivity(perturb):
+        """u at each speed: the RMS of the re-solves' changes at +u and -u."""
+        dv = []
+        for sign in (1.0, -1.0):
+            res = estimate(perturb(sign), **kwargs)
+            if not res.success:
+                notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
+                             f"({res.message})")
+            dv.append(np.asarray(res.delta_v_kt(vi)[0], dtype=float) - dv0)
+        return np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
+
+    terms = {}
+    for name, field, unit in SOURCES:
+        u = abs(getattr(inputs, field))
+        if u == 0.0:
+            terms[name] = np.zeros_like(vi)
+        elif name == "gps_velocity_bias":
+            # north and east: V_g + b - W = V_g - (W - b), the fit's wind takes b exactly
+            # (the tests re-solve to show it); only the vertical channel is left
+            terms[name] = (np.zeros_like(vi) if flight.gps_vd_mps is None else
+                           sensitivity(lambda s, u=u: gps_bias(flight, "gps_vd_mps", s * u)))
+        else:
+            perturb = PERTURBATIONS[name]
+            terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u))
+    for note in notes:
+        warnings.warn(note, stacklevel=2)
+    return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,
+                  inputs={name: (abs(getattr(inputs, field)), unit)
+                          for name, field, unit in SOURCES},
+                  warnings=tuple(dict.fromkeys(notes)))
+
+
+# --- perturbed flights (Flight, result, signed step) -> Flight --------------------------------
+
+def static_temperature_of(flight):
+    """The flight's static temperature, K: oat_k, else p_s/(R ρ), else ISA at alt_m, else 288.15."""
+    if flight.oat_k is not None:
+        return np.asarray(flight.oat_k, dtype=float)
+    if flight.ps_pa is not None:
+        return flight.ps_pa / (R_AIR_JKGK * flight.rho_kgm3)
+    if flight.alt_m is not None and np.any(np.isfinite(flight.alt_m)):
+        return np.full(flight.n, float(isa_temperature_k(np.nanmean(flight.alt_m))))
+    return np.full(flight.n, ISA_T0_K)
+
+
+def oat_error(flight, result, dt_k):
+    """The static temperature dt_k higher: ρ → ρ T/(T + dt), oat_k + dt."""
+    t = static_temperature_of(flight)
+    out = {"rho_kgm3": flight.rho_kgm3 * t / (t + dt_k)}
+    if flight.oat_k is not None:
+        out["oat_k"] = flight.oat_k + dt_k
+    return dataclasses.replace(flight, **out)
+
+
+def humidity_error(flight, result, drh_pct):
+    """Relative humidity drh_pct higher (lower): ρ and T_v (`oat_k`) through the virtual temperature.
+
+    The density change of +|drh| from the flight's humidity (0 when it has none, capped at
+    100 %RH) with the sign of drh, so the two sides of the central difference are symmetric.
+    """
+    t = static_temperature_of(flight)
+    ps = flight.ps_pa if flight.ps_pa is not None else flight.rho_kgm3 * R_AIR_JKGK * t
+    rh0 = np.zeros(flight.n) if flight.rh_pct is None else np.asarray(flight.rh_pct, float)
+    hi = np.minimum(rh0 + abs(drh_pct), 100.0)
+    rel = moist_density_kgm3(ps, t, hi) / moist_density_kgm3(ps, t, rh0) - 1.0
+    factor = 1.0 + np.sign(drh_pct) * rel
+    out = {"rho_kgm3": flight.rho_kgm3 * factor}
+    if flight.oat_k is not None:          # the virtual temperature the compressible fit uses
+        out["oat_k"] = flight.oat_k / factor
+    return dataclasses.replace(flight, **out)
+
+
+def gps_bias(flight, channel, bias_mps):
+    """A constant bias added to one GPS velocity channel."""
+    return dataclasses.replace(flight, **{channel: getattr(flight, channel) + bias_mps})
+
+
+def gps_latency_error(flight, result, dt_s):
+    """The GPS velocity dt_s older relative to the pressure: each channel read at t − dt."""
+    t = flight.time_s
+    out = {c: np.interp(t - dt_s, t, getattr(flight, c))
+           for c in ("gps_vn_mps", "gps_ve_mps", "gps_vd_mps") if getattr(flight, c) is not None}
+    return dataclasses.replace(flight, **out)
+
+
+def yaw_rate_rps(flight, result, smooth_s=1.0):
+    """Body yaw rate r = ψ̇ cos φ, rad/s, and V_t, m/s, from the air-relative GPS velocity.
+
+    ψ is the heading of V_g − W (W: the fitted wind), smoothed over `smooth_s` (the GPS is held
+    at its own rate); the bank of a coordinated turn, tan φ = V ψ̇ / g.
+    """
+    wn, we = wind_vector_mps(result.value("wind_speed_mps"), result.value("wind_from_deg"))
+    an, ae = flight.gps_vn_mps - wn, flight.gps_ve_mps - we
+    psi = np.unwrap(np.arctan2(ae, an))
+    dt = float(np.median(np.diff(flight.time_s)))
+    width = max(1, round(smooth_s / dt))
+    psi = np.convolve(psi, np.ones(width) / width, mode="same") if width > 1 else psi
+    psi_dot = np.gradient(psi, flight.time_s)
+    if width > 1:                               # the edges of "same" are half windows
+        psi_dot[:width] = psi_dot[width]
+        psi_dot[-width:] = psi_dot[-width - 1]
+    tas = np.hypot(an, ae)
+    return psi_dot / np.sqrt(1.0 + (tas * psi_dot / G0_MPS2) ** 2), tas
+
+
+def lever_arm_error(flight, result, arm_m):
+    """A probe at y = arm_m (right wing +) sees V_t − r y: q_ci scaled by (1 − r y / V_t)²."""
+    r, tas = yaw_rate_rps(flight, result)
+    return dataclasses.replace(flight, qci_pa=flight.qci_pa * (1.0 - r * arm_m / tas) ** 2)
+
+
+def qc_scale_error(flight, result, scale):
+    return dataclasses.replace(flight, qci_pa=flight.qci_pa * (1.0 + scale))
+
+
+def qc_offset_error(flight, result, offset_pa):
+    return dataclasses.replace(flight, qci_pa=flight.qci_pa + offset_pa)
+
+
+PERTURBATIONS = {"oat": oat_error, "humidity": humidity_error,
+                 "gps_latency": gps_latency_error, "probe_lever_arm": lever_arm_error,
+                 "qc_scale": qc_scale_error, "qc_offset": qc_offset_error}
+
+
+def inputs_from_options(**options):
+    """`BudgetInputs` from keyword options, refusing an unknown name (PitotcalError)."""
+    names = {f.name for f in dataclasses.fields(BudgetInputs)}
+    unknown = sorted(set(options) - names)
+    if unknown:
+        raise PitotcalError(f"unknown budget input {unknown[0]!r}; known: "
+                            f"{', '.join(sorted(names))}", param=unknown[0])
+    return BudgetInputs(**{k: v for k, v in options.items() if v is not None}).checked()

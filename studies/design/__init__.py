@@ -1,0 +1,1 @@
+"""The `design` study: the information-optimal schedule against the paper's profiles."""

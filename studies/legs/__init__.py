@@ -1,0 +1,1 @@
+"""The `legs` and `legs-flight` studies."""

@@ -1,0 +1,1 @@
+"""The `monitor` study: false alarms and detection delays, with an oracle and a fixed-threshold baseline."""

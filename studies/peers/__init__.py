@@ -1,0 +1,1 @@
+"""The `peers` study: the autopilots' own calibrators, re-implemented, against pitotcal."""

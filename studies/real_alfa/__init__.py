@@ -1,0 +1,1 @@
+"""The `real-alfa` study: the real ALFA Carbon-Z flight."""

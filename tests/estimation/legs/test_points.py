@@ -1,0 +1,159 @@
+"""The classic GPS leg methods per point: published worked examples, the linearised bounds
+against Monte Carlo, the observability rule, and simulated truth recovered within 3σ."""
+
+import numpy as np
+import pytest
+from pitotcal.estimation.legs.points import (
+    DOP_MAX,
+    circle_jacobian,
+    solve_point,
+    solve_points,
+    subsets,
+    three_leg,
+)
+from pitotcal.maneuvers.fly.legs import simulate_legs
+
+from pitotcal.core.errors import ObservabilityError
+from pitotcal.core.units import KT_TO_MPS, wind_polar
+from pitotcal.io.legs_csv import LegData
+
+
+def _g(gs, tk):
+    t = np.radians(tk)
+    gs = np.asarray(gs, dtype=float)
+    return np.column_stack([gs * np.cos(t), gs * np.sin(t)])
+
+
+def _legs(gs_kt, tk, ias_kt=150.0, alt_ft=5000.0, sd_kt=None, point="1"):
+    n = len(gs_kt)
+    from pitotcal.core import airdata
+    return LegData(point=(point,) * n, ias_kt=np.full(n, ias_kt),
+                   qci_pa=np.full(n, float(airdata.qc_from_cas_pa(ias_kt * KT_TO_MPS))),
+                   pressure_alt_m=np.full(n, alt_ft * 0.3048), oat_k=np.full(n, 278.15),
+                   groundspeed_mps=np.asarray(gs_kt, float) * KT_TO_MPS,
+                   track_deg=np.asarray(tk, float), duration_s=np.full(n, np.nan),
+                   groundspeed_sd_mps=np.full(n, np.nan if sd_kt is None else sd_kt * KT_TO_MPS),
+                   source="legs.csv", lines=tuple(range(2, n + 2)))
+
+
+def test_ntps_three_leg_example():
+    """NTPS "GPS PEC" spreadsheet sample data (Naval Test Pilot School, GPS%20PEC.XLS), legs
+    1-3 as used to validate K. Horton's aerocalc `ssec.gps2tas` (tests/test_ssec.py of
+    github.com/khorton/AeroCalc_Package): ground speeds 178, 185, 188 kt on tracks 178°, 82°,
+    355° give TAS 183.05 kt, wind 5.26 kt from 194.5°, headings 178.46°, 83.52°, 354.45°."""
+    wn, we, v = three_leg(_g([178, 185, 188], [178, 82, 355]))
+    speed, frm = wind_polar(wn, we)
+    assert round(v, 2) == 183.05
+    assert round(float(speed), 2) == 5.26 and round(float(frm), 1) == 194.5
+    g = _g([178, 185, 188], [178, 82, 355])
+    headings = np.degrees(np.arctan2(g[:, 1] - we, g[:, 0] - wn)) % 360
+    # printed 178.46 (ours 178.468: the source truncates, its test allows 1e-4 relative)
+    np.testing.assert_allclose(headings, [178.46, 83.52, 354.45], atol=0.01)
+
+
+def test_ntps_four_leg_example_horton_subsets():
+    """NTPS GPS PEC spreadsheet, four-leg tab sample data (same source as above): ground
+    speeds 178, 185, 188, 184 kt on tracks 178°, 82°, 355°, 265°; the four 3-leg solutions
+    (legs 123, 234, 341, 412) average to TAS 183.73 kt with standard deviation 0.827 kt, winds
+    5.26/194.52°, 3.58/181.52°, 5.15/162.7°, 6.44/177.95° (kt / from)."""
+    gs, tk = [178, 185, 188, 184], [178, 82, 355, 265]
+    sols = np.array([three_leg(_g(np.take(gs, s), np.take(tk, s))) for s in subsets(4)])
+    assert round(sols[:, 2].mean(), 2) == 183.73
+    assert round(float(np.std(sols[:, 2], ddof=1)), 3) == 0.827
+    winds = [wind_polar(w[0], w[1]) for w in sols]
+    assert [round(float(s), 2) for s, _ in winds] == [5.26, 3.58, 5.15, 6.44]
+    assert [round(float(d), 2) for _, d in winds] == [194.52, 181.52, 162.70, 177.95]
+    # through the per-point solver (a leg file in knots): the same mean and SD
+    sol, _ = solve_point(_legs(gs, tk), "1")
+    assert sol.method == "4-leg" and sol.bound == "scatter"
+    assert round(sol.tas_mps / KT_TO_MPS, 2) == 183.73
+    assert round(sol.tas_subset_sd_mps / KT_TO_MPS, 3) == 0.827
+
+
+def test_gray_1998_example():
+    """D. Gray, "Using GPS to accurately establish True Airspeed (TAS)", June 1998, worked
+    example, as transcribed in github.com/fugalh/TAS (doug.ipynb, "Doug's results"; the paper's
+    own page was not readable here): 140 kt on track 192°, 112 kt on 283°, 120 kt on 020° give
+    TAS 130 kt, headings 200°, 287.8°, 11.7°, wind 20.6 kt from 314.8°."""
+    g = _g([140, 112, 120], [192, 283, 20])
+    wn, we, v = three_leg(g)
+    speed, frm = wind_polar(wn, we)
+    assert round(v) == 130
+    assert round(float(speed), 1) == 20.6 and round(float(frm), 1) == 314.8
+    headings = np.degrees(np.arctan2(g[:, 1] - we, g[:, 0] - wn)) % 360
+    assert round(headings[0]) == 200 and list(np.round(headings[1:], 1)) == [287.8, 11.7]
+
+
+def test_horton_kitplanes_averaging_bias():
+    """K. Horton, "Flight Testing: Finding TAS from GPS Data", KITPLANES: 100 kt TAS, wind 20 kt
+    from the west, headings 000/090/180/270 give ground speeds 102, 120, 102, 80 kt, whose
+    average, 101 kt, is not the TAS: the known bias of averaging ground speeds. The 4-leg method
+    (on the tracks those headings make) gives 100 kt; the naive average is reported beside it."""
+    track_n = np.degrees(np.arctan2(20, 100))
+    gs = [np.hypot(100, 20), 120, np.hypot(100, 20), 80]
+    assert [round(x) for x in gs] == [102, 120, 102, 80]
+    sol, _ = solve_point(_legs(gs, [track_n, 90, 180 - track_n, 270]), "1")
+    assert round(sol.tas_mps / KT_TO_MPS, 6) == 100.0
+    assert round(sol.naive_tas_mps / KT_TO_MPS) == 101
+
+
+def test_linearised_bounds_match_monte_carlo():
+    """The Jacobian of the closed form against 20,000 noisy replicates: σ_V and σ_w within 3 %,
+    and the estimator's bias (second order) below 5 % of σ_V."""
+    rng = np.random.default_rng(7)
+    g0 = _g([95.0, 118.0, 104.0], [5.0, 95.0, 200.0])
+    x0 = three_leg(g0)
+    jac = circle_jacobian(g0, x0)
+    sd = 1.0
+    cov = sd ** 2 * jac @ jac.T
+    xs = np.array([three_leg(g0 + rng.normal(0, sd, g0.shape)) for _ in range(20000)])
+    np.testing.assert_allclose(xs.std(axis=0), np.sqrt(np.diag(cov)), rtol=0.03)
+    assert abs(xs[:, 2].mean() - x0[2]) < 0.05 * np.sqrt(cov[2, 2])
+
+
+@pytest.mark.parametrize("tracks", [(0, 90, 180), (0, 120, 240), (10, 100, 350), (0, 45, 90)])
+def test_valid_three_leg_patterns_are_accepted(tracks):
+    """N/E/S (the pattern a 180° rule refuses) and other spreads: solved, DOP small."""
+    legs, truth = simulate_legs(ias_kt=(120,), tracks_deg=tracks, leg_sd_kt=0.0)
+    sol, _notes = solve_point(legs, "1")
+    assert sol.dop < DOP_MAX and sol.method == "3-leg"
+    assert abs(sol.tas_mps - truth.tas_mps[0]) < 1e-6
+    assert abs(sol.dv_kt - truth.dv_kt[0]) < 1e-6
+
+
+@pytest.mark.parametrize("gs, tracks, match", [
+    ([100, 120, 110], [0, 180, 0], "lie on one line in the velocity plane"),
+    ([100, 101, 102], [0, 5, 10], (r"nearly collinear: 1 kt of ground-velocity error would move "
+                                   r"the TAS by \d+ kt \(limit 10\)")),
+    ([100, 120], [0, 90], "point 1 has 2 legs: three legs on different tracks are needed"),
+])
+def test_degenerate_patterns_are_refused(gs, tracks, match):
+    with pytest.raises(ObservabilityError, match=match) as err:
+        solve_point(_legs(gs, tracks), "1")
+    assert err.value.exit_status == 3 and "\n" not in str(err.value)
+
+
+def test_four_legs_with_one_degenerate_subset_keep_the_others():
+    legs = _legs([100, 100.5, 120, 80], [0, 0.5, 90, 270])
+    sol, notes = solve_point(legs, "1")
+    assert sum("subset left out" in n for n in notes) == 2      # legs 1 and 2 with 3 or 4
+    assert sol.dop < DOP_MAX and np.isfinite(sol.tas_mps)
+
+
+@pytest.mark.parametrize("state_sd", [True, False])
+def test_simulated_points_recover_truth_within_3_sigma(state_sd):
+    legs, truth = simulate_legs(seed=11, leg_sd_kt=0.5, state_sd=state_sd)
+    sols, _notes = solve_points(legs)
+    assert [s.bound for s in sols] == ["stated" if state_sd else "scatter"] * len(sols)
+    for s, tas, dv in zip(sols, truth.tas_mps, truth.dv_kt):
+        assert abs(s.tas_mps - tas) <= 1.5 * s.tas_half_mps          # 1.5 × 2σ = 3σ
+        assert abs(s.dv_kt - dv) <= 1.5 * s.dv_half_kt
+        speed, _frm = s.wind
+        assert abs(speed - 15 * KT_TO_MPS) < 1.0
+
+
+def test_three_legs_without_stated_accuracy_have_no_bound():
+    legs, _ = simulate_legs(ias_kt=(100,), tracks_deg=(0, 120, 240), state_sd=False)
+    sol, notes = solve_point(legs, "1")
+    assert sol.bound == "none" and np.isnan(sol.dv_half_kt)
+    assert any("no bound" in n for n in notes)

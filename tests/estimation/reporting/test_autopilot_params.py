@@ -1,0 +1,97 @@
+"""Autopilot airspeed parameters: the ratio/scale formula against a known constant error, the
+files read back by pymavlink's own loader and by a QGC parse, the SITL log, the refusals."""
+
+import math
+
+import pytest
+from pitotcal.estimation.reporting.autopilot_params import recommend, write_parameter_file
+from synthetic import synthetic_flight
+
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.units import RHO0_KGM3
+from pitotcal.io.param_files import read_qgc_params
+
+K1 = 0.18        # ArduPilot's default ratio 1.9936 is about this error: 2/(rho0 (1-k1))
+
+
+@pytest.fixture(scope="module")
+def constant_flight():
+    return synthetic_flight(seed=3, n=6000, model="constant", k=(K1,), qc_noise_pa=0.3)[0]
+
+
+def test_ardupilot_ratio_recovers_the_truth_and_loads_in_pymavlink(constant_flight, tmp_path):
+    from pymavlink.mavparm import MAVParmDict
+
+    rec = recommend(constant_flight, "ArduPilot", current=1.6)
+    truth = 2.0 / (RHO0_KGM3 * (1.0 - K1))
+    assert abs(rec.value - truth) <= rec.two_sigma and rec.two_sigma < 0.01 * truth
+    assert rec.name == "ARSPD_RATIO" and rec.track_spread_deg > 350
+    path = write_parameter_file(rec, tmp_path / "new.param")
+    loaded = MAVParmDict()
+    assert loaded.load(str(path))
+    assert loaded["ARSPD_RATIO"] == pytest.approx(rec.value, abs=1e-6)
+    text = path.read_text()
+    assert "2 sigma" in text and "current value 1.6" in text and "new / current" in text
+
+
+def test_a_stated_gps_error_reaches_the_recommendation(constant_flight):
+    """identify --params passes the receiver's stated slow velocity error on: a slow GPS bias
+    the residuals cannot show widens the ratio's bound (issue 11)."""
+    plain = recommend(constant_flight, "ArduPilot", current=1.6)
+    stated = recommend(constant_flight, "ArduPilot", current=1.6, gps_error_sigma_mps=0.3,
+                       gps_error_tau_s=60.0)
+    truth = 2.0 / (RHO0_KGM3 * (1.0 - K1))
+    assert stated.two_sigma > 1.2 * plain.two_sigma
+    assert abs(stated.value - truth) <= stated.two_sigma
+
+
+def test_px4_scale_is_the_square_root_and_parses_as_qgc(constant_flight, tmp_path):
+    rec = recommend(constant_flight, "PX4", current=1.0)
+    assert abs(rec.value - 1.0 / math.sqrt(1.0 - K1)) <= rec.two_sigma
+    path = write_parameter_file(rec, tmp_path / "new.params")
+    assert read_qgc_params(path) == {"ASPD_SCALE_1": pytest.approx(rec.value, abs=1e-6)}
+    rows = [r for r in path.read_text().splitlines() if not r.startswith("#")]
+    assert rows == [f"1\t1\tASPD_SCALE_1\t{rec.value:.6f}\t9"]
+
+
+def test_refuses_a_track_that_did_not_turn_enough():
+    # 0.6 of a turn: identify itself accepts it (> 180 deg), a parameter needs 270
+    flight = synthetic_flight(seed=1, n=3000, model="constant", k=(K1,), turns=0.6)[0]
+    with pytest.raises(PitotcalError, match=r"turned through only 2\d\d deg \(need 270"):
+        recommend(flight, "ArduPilot", current=1.9936)
+
+
+def test_refuses_when_one_scale_cannot_represent_the_error():
+    # Δp/q_c from -0.05 at 70 kt to -0.02 at 100 kt: the inverse model departs from one scale
+    flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -40.0))[0]
+    with pytest.raises(PitotcalError, match="a single ARSPD_RATIO cannot represent"):
+        recommend(flight, "ArduPilot", current=1.9936)
+
+
+def test_refuses_bounds_too_wide_to_improve_on_the_current_value():
+    flight = synthetic_flight(seed=4, n=400, model="constant", k=(K1,), qc_noise_pa=25.0,
+                              turbulence_mps=1.5)[0]
+    truth = 2.0 / (RHO0_KGM3 * (1.0 - K1))
+    with pytest.raises(PitotcalError, match="bounds too wide to improve on the current value"):
+        recommend(flight, "ArduPilot", current=truth)
+
+
+def test_unknown_autopilot_is_refused(constant_flight):
+    with pytest.raises(PitotcalError, match="ArduPilot or PX4 log"):
+        recommend(constant_flight, None)
+
+
+def test_refuses_a_fit_that_did_not_converge(constant_flight, monkeypatch):
+    import dataclasses
+
+    from pitotcal.estimation.identification import identify as identification
+
+    real = identification.identify
+
+    def stalled(*args, **kw):
+        return dataclasses.replace(real(*args, **kw), success=False,
+                                   message="Maximum_Iterations_Exceeded")
+
+    monkeypatch.setattr(identification, "identify", stalled)
+    with pytest.raises(PitotcalError, match="did not converge \\(Maximum_Iterations"):
+        recommend(constant_flight, "ArduPilot", current=1.9936)
