@@ -27,7 +27,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     sys.path.insert(0, str(ROOT / "tests"))
     from pitotcal.estimation import identify
-    from pitotcal.estimation.uncertainty.budget import BudgetInputs, uncertainty_budget
+    from pitotcal.estimation.identification.budget import BudgetInputs, uncertainty_budget
     from synthetic import synthetic_flight
 
     inputs = BudgetInputs(probe_arm_m=1.0)

@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def _flight(n, rate_hz=50.0):
     from pitotcal.maneuvers import simulate
-    from pitotcal.studies.common import get_plan
+    from pitotcal.studies.engine.common import get_plan
 
     plan = get_plan(duration_s=n / rate_hz)
     return simulate(plan, seed=1, rate_hz=rate_hz)[0]

@@ -40,9 +40,9 @@ _EXPORTS = {
     "tracking_warnings": ".fly.truth",
     "truth_path_for": ".fly.truth",
     "write_truth_json": ".fly.truth",
-    "DrydenScales": ".fly.turbulence",
-    "dryden_gusts": ".fly.turbulence",
-    "dryden_scales": ".fly.turbulence",
+    "DrydenScales": ".turbulence",
+    "dryden_gusts": ".turbulence",
+    "dryden_scales": ".turbulence",
 }
 
 __all__ = sorted(_EXPORTS)  # noqa: PLE0605

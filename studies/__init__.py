@@ -1,6 +1,6 @@
 """Studies: Monte Carlo over simulated flights (on Dask), the paper's figures reproduced, the
 real ALFA flight, the autopilots' calibrators compared, and `pitotcal demo`. Every study is one
-`studies.study.Study` in the table `studies.catalog.STUDIES`, each in its own module
+`studies.engine.study.Study` in the table `studies.catalog.STUDIES`, each in its own module
 (`studies.accuracy.coverage`...).
 
 Example
@@ -23,10 +23,10 @@ _EXPORTS = {
     "run_study": ".catalog",
     "study_names": ".catalog",
     "run_demo": ".demo",
-    "read_table": ".runner",
-    "run_cases": ".runner",
-    "run_one": ".runner",
-    "write_table": ".runner",
+    "read_table": ".engine.runner",
+    "run_cases": ".engine.runner",
+    "run_one": ".engine.runner",
+    "write_table": ".engine.runner",
 }
 
 __all__ = sorted([*_EXPORTS, "STUDY_NAMES"])  # noqa: PLE0605

@@ -26,17 +26,17 @@ from .accuracy.maneuvers import STUDY as MANEUVERS
 from .monitor.study import STUDY as MONITOR
 from .accuracy.noise import STUDY as NOISE
 from .real_alfa.study import STUDY as REAL_ALFA
-from .runner import RunsInterrupted, count_errors, output_folder, write_table
+from .engine.runner import RunsInterrupted, count_errors, output_folder, write_table
 from .accuracy.sample_size import STUDY as SAMPLE_SIZE
 from .accuracy.sensitivity import STUDY as SENSITIVITY
-from .study import StudySettings
+from .engine.study import StudySettings
 from .accuracy.wind import STUDY as WIND
 
 __all__ = ["STUDIES", "StudyInterrupted", "get_study", "rerun", "run_study", "study_names"]
 
 log = logging.getLogger(__name__)
 
-# Every study, by the name it has on the command line (each a `studies.study.Study`).
+# Every study, by the name it has on the command line (each a `studies.engine.study.Study`).
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
                                PEERS, LEGS, DESIGN, MONITOR, BUDGET,
                                LEGS_FLIGHT, NOISE,
@@ -80,7 +80,7 @@ def run_study(name, *, runs=None, out_dir=".", seed=0, workers=None, scheduler=N
         Base seed; run i of the table used ``seed + i`` (or ``seed + seed_offset``; see the
         ``seed`` column).
     workers, scheduler, progress :
-        Where runs go (`studies.runner.run_cases`).
+        Where runs go (`studies.engine.runner.run_cases`).
     quick : bool
         A small grid for tests and smoke runs.
     data_dir : str or Path, optional

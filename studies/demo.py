@@ -18,9 +18,9 @@ from pitotcal.core.scenario import T2_PLAN, TRUE_K
 from pitotcal.io.atomic import atomic_open
 from pitotcal.io.jsonfile import write_json
 
-from .common import truth_delta_v_kt
-from .figures import new_figure, save
-from .runner import output_folder
+from .engine.common import truth_delta_v_kt
+from .engine.figures import new_figure, save
+from .engine.runner import output_folder
 
 __all__ = ["DEMO_SIM", "DemoResult", "format_table", "run_demo"]
 
@@ -83,7 +83,7 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     import time
 
     from pitotcal.estimation import identify
-    from pitotcal.estimation.uncertainty.budget import uncertainty_budget
+    from pitotcal.estimation.identification.budget import uncertainty_budget
     from pitotcal.estimation.reporting.budget_tables import add_budget
     from pitotcal.maneuvers import plan_maneuver, simulate, write_truth_json
 

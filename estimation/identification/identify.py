@@ -99,7 +99,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
 
 def estimate(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
-    """`identify`'s estimate alone, for re-solves that use only it (`estimation.uncertainty.budget`).
+    """`identify`'s estimate alone, for re-solves that use only it (`estimation.identification.budget`).
 
     The same checks, gates, outlier trimming and fit, so the same parameters; without the
     colored-residual covariance and the consistency checks: `covariance` is the plain one and

@@ -217,7 +217,7 @@ class OutputErrorProblem:
             the colored-residual covariance (`covariance.colored_covariance`).
         colored : bool
             False: no colored-residual covariance (`covariance` is the plain one), for
-            re-solves that use only the estimate (`estimation.uncertainty.budget`).
+            re-solves that use only the estimate (`estimation.identification.budget`).
 
         Returns
         -------

@@ -149,22 +149,22 @@ class IdentificationResult:
     # --- presentation (estimation/report.py) --------------------------------------------
     def summary(self):
         """Human summary in knots and degrees (what `pitotcal identify` prints)."""
-        from ..reporting.view import summary
+        from .view import summary
         return summary(self)
 
     def to_dict(self):
         """The JSON of docs/interfaces.md §3."""
-        from ..reporting.view import to_dict
+        from .view import to_dict
         return to_dict(self)
 
     def correction_table(self, step_kt=None):
         """Airspeed-correction rows {vi_kt, dv_kt, dv_2sigma_kt} over the flown V_i range."""
-        from ..reporting.view import correction_table
+        from .view import correction_table
         return correction_table(self, step_kt=step_kt)
 
     def plot(self, path=None):
         """The calibration figure (paper Figs. 7-8 style); saved to `path` when given."""
-        from ..reporting.view import plot
+        from .view import plot
         return plot(self, path)
 
     def _coef_cov(self, plain):

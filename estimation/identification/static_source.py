@@ -130,7 +130,7 @@ def static_source_products(result, vi_kt, plain=False):
 def plot_static_error(ax, result, implied_ratio, vi_range_kt):
     """Δp_p/q_cic vs M_ic with its 2σ band, and each sample's ratio from the residuals.
 
-    `implied_ratio` is the per-sample Δp/q_c (`estimation.reporting.view`); Δp_p/q_cic = g / (1 - g).
+    `implied_ratio` is the per-sample Δp/q_c (`estimation.identification.view`); Δp_p/q_cic = g / (1 - g).
     `vi_range_kt` the (lowest, highest) V_ic flown.
     """
     qci = np.asarray(result.qci_pa, dtype=float)
@@ -175,7 +175,7 @@ def plot_altimeter_correction(ax, result, vi_range_kt):
     ax.legend(fontsize=8, loc="best")
 
 
-# --- summary lines (estimation.reporting.view) --------------------------------------------
+# --- summary lines (estimation.identification.view) --------------------------------------------
 
 def static_statement(result):
     """(what was assumed or measured, the static-error fit or None) of a compressible result."""

@@ -110,7 +110,7 @@ class LegFit:
 
     def correction_table(self, step_kt=None):
         """Rows {vi_kt, dv_kt, dv_2sigma_kt, vc_kt} from the lowest to the highest V_ic flown."""
-        from ..reporting.view import default_step_kt
+        from ..identification.view import default_step_kt
 
         lo, hi = self.vi_range_kt
         step = step_kt or default_step_kt(hi - lo)

@@ -13,7 +13,7 @@ functions add to what it makes:
 
 import numpy as np
 
-from ..uncertainty.budget import COVERAGE_K
+from ..identification.budget import COVERAGE_K
 
 __all__ = ["add_budget", "budget_summary", "plot_budget_band"]
 

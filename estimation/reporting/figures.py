@@ -2,7 +2,7 @@
 
 From the result JSON alone: the airspeed correction ΔV vs V_i with its 2σ and U bands and the
 compliance limit, and the altimeter correction ΔH_pc when the result carries it. With the
-flight: the paper-style calibration figure of `estimation.reporting.view.plot` (its residual panel
+flight: the paper-style calibration figure of `estimation.identification.view.plot` (its residual panel
 included) and the ground track integrated from GPS velocity beside the residual histogram.
 """
 

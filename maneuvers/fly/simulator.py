@@ -5,7 +5,7 @@
 1. options: every argument checked before any work (maneuvers.fly.options);
 2. references: the plan on the dynamics grid, which steps at DYNAMICS_RATE_HZ or faster
    whatever the logging rate (`References`, `references`);
-3. wind field: the mean wind, a slow linear drift and Dryden turbulence (maneuvers.fly.turbulence)
+3. wind field: the mean wind, a slow linear drift and Dryden turbulence (maneuvers.turbulence)
    on the same grid (`WindField`, `wind_field`);
 4. flying: lateral guidance and the PI auto-throttle of maneuvers.plan.autothrottle step the aircraft
    through pitotcal.core.dynamics with Heun's method (maneuvers.fly.guidance.fly);
@@ -36,7 +36,7 @@ from .truth import (
     truth_path_for,
     write_truth_json,
 )
-from .turbulence import dryden_gusts, dryden_scales
+from ..turbulence import dryden_gusts, dryden_scales
 
 from pitotcal.core.airdata import qc_from_tas_sq_pa
 from pitotcal.core.checks import integer
@@ -171,7 +171,7 @@ def wind_field(plan, refs, opts, rng):
     """Mean wind + linear drift about the plan's middle + Dryden gusts (path axes).
 
     wind(t) = mean + drift (t - t_mid), so the process mean over the record is the mean; the
-    gusts come from `rng` (maneuvers.fly.turbulence, MIL-F-8785C at the plan's mean altitude).
+    gusts come from `rng` (maneuvers.turbulence, MIL-F-8785C at the plan's mean altitude).
     """
     t, dt = refs.time_s, refs.dt_s
     n_dyn = t.size
@@ -252,7 +252,7 @@ def _plunge(refs, wind, states, opts):
     if not opts.vertical_gusts or not np.any(wind.gust_w_mps):
         return states, None
     from .guidance import GUIDANCE_GAINS
-    from .turbulence import plunge_response
+    from ..turbulence import plunge_response
 
     sub = refs.steps_per_sample
     rho = float(np.mean(isa_density_kgm3(states[:, 2])))

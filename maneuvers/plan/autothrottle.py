@@ -286,7 +286,7 @@ def check_autothrottle(plan, loop=None, *, turbulence_mps=0.0, turbulence_length
     -s/(s+X_u)/(1+CP)), each linear between the samples. CAS follows TAS at constant altitude
     by the plan's CAS/TAS ratio.
     """
-    from ..fly.turbulence import along_path_gust, dryden_scales
+    from ..turbulence import along_path_gust, dryden_scales
 
     limits = limits or Limits()
     rate_hz = positive("rate_hz", rate_hz)

@@ -242,7 +242,7 @@ def _circle_bank(schedule, radius_m, bank_max_rad, coverage_rad):
 def default_noise(turbulence_mps, altitude_m, tas_mps):
     """The residual noise of a flight in `turbulence_mps` of Dryden turbulence at the plan
     altitude (simulator defaults for the sensors): tau = L_u / mean TAS."""
-    from ..fly.turbulence import dryden_scales
+    from ..turbulence import dryden_scales
 
     scales = dryden_scales(max(altitude_m, 0.0), max(turbulence_mps, 1e-9))
     return ResidualNoise(turbulence_mps=turbulence_mps,

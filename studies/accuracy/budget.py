@@ -3,7 +3,7 @@
 The T-2 maneuver (planner defaults: 70-100 KCAS, 244 m, 5 m/s wind) is flown with
 compressible truth (the static error in the logged ps_pa) in calm air, light and moderate
 turbulence; each flight is identified (the default compressible fit) and its uncertainty budget computed
-with the documented default inputs (estimation.uncertainty.budget.BudgetInputs) and a wingtip probe 1 m
+with the documented default inputs (estimation.identification.budget.BudgetInputs) and a wingtip probe 1 m
 out (`probe_arm_m` = 1, the issue's example; 0 for a probe on the centre line). The table has,
 per flight, the largest standard uncertainty of ΔV over the flown range for each source; the
 figure sets them beside each other per turbulence level. The calm-air statistical part is what
@@ -12,9 +12,9 @@ a Monte Carlo of our own simulator shows; the Type B terms are what it cannot.
 
 import numpy as np
 
-from ..common import fly, group, identify_flight, score, truth_for
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.common import fly, group, identify_flight, score, truth_for
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["PROBE_ARM_M", "STUDY", "TURBULENCE_MPS"]
 
@@ -26,7 +26,7 @@ _FLOOR_KT = 1e-4          # bars below this (the GPS bias, taken by the wind) dr
 
 def task(seed, turbulence_mps):
     """One flight: its score against truth, and the budget's terms (max over V_i), kt."""
-    from pitotcal.estimation.uncertainty.budget import BudgetInputs, uncertainty_budget
+    from pitotcal.estimation.identification.budget import BudgetInputs, uncertainty_budget
 
     flight, truth = fly(None, {"turbulence_mps": turbulence_mps, "air_data": "compressible"},
                         seed)

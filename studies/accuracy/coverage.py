@@ -13,9 +13,9 @@ import dataclasses
 
 import numpy as np
 
-from ..common import column, fly, ok_rows, percent, score, truth_for
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.common import column, fly, ok_rows, percent, score, truth_for
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["PARAMETERS", "STUDY", "TURBULENCE_MPS", "run_scored", "wilson_interval"]
 

@@ -11,10 +11,10 @@ range, and how often it does so with no warning from the checks (a tight wrong a
 
 import numpy as np
 
-from ..common import column, fly, identify_flight, ok_rows, percent, score, truth_for
+from ..engine.common import column, fly, identify_flight, ok_rows, percent, score, truth_for
 from .coverage import wilson_interval
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["LEAK", "ONSET_S", "PLANS", "STUDY", "TURBULENCE_MPS"]
 

@@ -8,9 +8,9 @@ planned in that time is a row with the planner's message.
 
 import numpy as np
 
-from ..common import accuracy_summary, group, run_fly_identify
-from ..figures import new_figure, plain_log_ticks, save
-from ..study import MonteCarloStudy
+from ..engine.common import accuracy_summary, group, run_fly_identify
+from ..engine.figures import new_figure, plain_log_ticks, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["DURATIONS_S", "PROFILES", "STUDY"]
 

@@ -17,10 +17,10 @@ against it are kept as ``P_z_flown`` (they are smaller: the bounds look 1.3-1.6x
 
 import numpy as np
 
-from ..common import column, ok_rows, percent
+from ..engine.common import column, ok_rows, percent
 from .coverage import PARAMETERS, run_scored, wilson_interval
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["IDENTIFY_OPTIONS", "NOISE_CASES", "STUDY"]
 

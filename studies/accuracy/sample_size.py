@@ -8,7 +8,7 @@ samples come from each speed: N = 10,000 is a dwell of 100 s at each airspeed.
 
 import numpy as np
 
-from ..common import (
+from ..engine.common import (
     accuracy_summary,
     column,
     fly,
@@ -19,8 +19,8 @@ from ..common import (
     stats,
     truth_for,
 )
-from ..figures import new_figure, plain_log_ticks, save
-from ..study import MonteCarloStudy
+from ..engine.figures import new_figure, plain_log_ticks, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["S2_PLAN", "SAMPLE_COUNTS", "STUDY"]
 

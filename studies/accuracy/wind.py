@@ -10,9 +10,9 @@ import numpy as np
 
 from pitotcal.core.units import mps_to_kt
 
-from ..common import column, group, ok_rows, percent, run_fly_identify, stats
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.common import column, group, ok_rows, percent, run_fly_identify, stats
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["PROFILES", "STUDY", "WINDS"]
 

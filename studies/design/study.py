@@ -17,9 +17,9 @@ without ramps - what no schedule can beat.
 
 import numpy as np
 
-from ..common import column, fly, group, identify_flight, ok_rows, score, truth_delta_v_kt
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.common import column, fly, group, identify_flight, ok_rows, score, truth_delta_v_kt
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["DESIGNS", "STUDY", "plan_kwargs"]
 
@@ -84,7 +84,7 @@ def predicted_kt(design, duration_s):
     """The predicted worst-row 2σ of ΔV over 72-98 KIAS (what identify reports) of a case."""
     from pitotcal.maneuvers.plan.design import predict_plan_band_kt
 
-    from ..common import get_plan
+    from ..engine.common import get_plan
 
     plan = get_plan(**plan_kwargs(design, duration_s))
     return float(predict_plan_band_kt(plan, TURBULENCE_MPS, _GRID)[0].max())
@@ -93,7 +93,7 @@ def predicted_kt(design, duration_s):
 def emulated_kt(design, duration_s, draws=EMULATED_DRAWS):
     """(median, mean) worst-row 2σ of ΔV that identify's covariance reports on residuals drawn
     from the design's noise model on the case's planned path (`design_reported`)."""
-    from ..common import get_plan
+    from ..engine.common import get_plan
     from .reported import emulated_reported_kt
 
     plan = get_plan(**plan_kwargs(design, duration_s))

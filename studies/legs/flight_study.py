@@ -13,9 +13,9 @@ turn in any) and the share of the flown legs' time they used.
 
 import numpy as np
 
-from ..common import column, percent
-from ..figures import new_figure, save
-from ..study import MonteCarloStudy
+from ..engine.common import column, percent
+from ..engine.figures import new_figure, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["IAS_KT", "METHODS", "STUDY"]
 

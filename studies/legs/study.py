@@ -12,9 +12,9 @@ paper's argument (one global fit beats per-point solutions) on leg data.
 
 import numpy as np
 
-from ..common import column, group, percent
-from ..figures import new_figure, plain_log_ticks, save
-from ..study import MonteCarloStudy
+from ..engine.common import column, group, percent
+from ..engine.figures import new_figure, plain_log_ticks, save
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["BOUNDS", "IAS_KT", "STUDY"]
 

@@ -16,10 +16,10 @@ import functools
 
 import numpy as np
 
-from ..common import column, fly, group
-from ..figures import new_figure, save
+from ..engine.common import column, fly, group
+from ..engine.figures import new_figure, save
 from .baseline import fixed_threshold_alarms
-from ..study import MonteCarloStudy
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["CONDITIONS", "DESIGN_RATES", "FAULTS", "STUDY"]
 

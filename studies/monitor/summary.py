@@ -3,7 +3,7 @@ bound) per condition, detection per fault, and the issue's targets, met or not."
 
 import numpy as np
 
-from ..common import column, group
+from ..engine.common import column, group
 
 __all__ = ["headline_of", "poisson_upper", "summarize_rows"]
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..figures import new_figure, plain_log_ticks, save
+from ..engine.figures import new_figure, plain_log_ticks, save
 
 __all__ = ["plot_peers"]
 

@@ -2,7 +2,7 @@
 flight time.
 
 Each run flies one seeded simulated calibration flight (`maneuvers.plan_maneuver` +
-`maneuvers.simulate`, through `studies.common.fly`), then for each flight time T uses only the
+`maneuvers.simulate`, through `studies.engine.common.fly`), then for each flight time T uses only the
 first T seconds:
 
 - pitotcal: `estimation.identify` on [0, T] (it refuses, with ObservabilityError, while the
@@ -28,11 +28,11 @@ from pitotcal.core.errors import ObservabilityError, PitotcalError
 from pitotcal.core.scenario import TRUE_K
 
 from .baselines import delta_v_kt_from_k1
-from ..common import fly, stats, truth_delta_v_kt, vi_grid_kt, window_wind
+from ..engine.common import fly, stats, truth_delta_v_kt, vi_grid_kt, window_wind
 from .ardupilot import ardupilot_autocal
 from .figure import plot_peers
 from .px4 import px4_wind_estimator
-from ..study import MonteCarloStudy
+from ..engine.study import MonteCarloStudy
 
 __all__ = ["METHODS", "STUDY", "TRUTH_CASES", "compare_one_flight", "peer_task"]
 

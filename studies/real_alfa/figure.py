@@ -4,7 +4,7 @@ pitotcal (one value ± 2σ), the peer filters (over time) and the autopilot's ow
 import numpy as np
 
 from ..peers.baselines import k1_from_ardupilot_ratio
-from ..figures import save
+from ..engine.figures import save
 
 __all__ = ["plot_real_flight"]
 

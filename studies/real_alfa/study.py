@@ -30,8 +30,8 @@ from ..peers.baselines import ardupilot_ratio_from_k1, k1_from_ardupilot_ratio
 from ..peers.ardupilot import ardupilot_autocal
 from ..peers.px4 import px4_wind_estimator
 from .figure import plot_real_flight
-from ..runner import RunsInterrupted
-from ..study import Collected
+from ..engine.runner import RunsInterrupted
+from ..engine.study import Collected
 
 __all__ = ["STUDY", "RealAlfaStudy", "RealFlightAnalysis", "analyse_real_flight"]
 
@@ -244,7 +244,7 @@ def _write_tracks(path, ardu, px4, ap):
 
 @dataclass(frozen=True)
 class RealAlfaStudy:
-    """The `real-alfa` study: one run on the real flight (`studies.study.Study`)."""
+    """The `real-alfa` study: one run on the real flight (`studies.engine.study.Study`)."""
 
     name: str = NAME
     description: str = ("the real ALFA Carbon-Z ArduPlane flight: pitotcal vs the autopilot's "

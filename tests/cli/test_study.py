@@ -6,8 +6,8 @@ import json
 
 import pytest
 from pitotcal.studies import catalog
-from pitotcal.studies.runner import echo_task, read_table
-from pitotcal.studies.study import MonteCarloStudy
+from pitotcal.studies.engine.runner import echo_task, read_table
+from pitotcal.studies.engine.study import MonteCarloStudy
 
 import pitotcal.cli.study as study_cli
 from pitotcal.cli import main

@@ -4,7 +4,7 @@ import pytest
 @pytest.fixture
 def fresh_cache():
     """Empty the per-process plan/flight caches of the studies around a test."""
-    from pitotcal.studies import common
+    from pitotcal.studies.engine import common
 
     common._fly_cached.cache_clear()
     yield

@@ -4,7 +4,7 @@ written "6×10⁻¹", 8.5% titled "8%", a wind direction running to 390°."""
 import numpy as np
 from pitotcal.studies.accuracy import coverage
 from pitotcal.studies.accuracy import maneuvers as maneuvers_study
-from pitotcal.studies.figures import new_figure, plain_log_ticks
+from pitotcal.studies.engine.figures import new_figure, plain_log_ticks
 from pitotcal.studies.real_alfa.figure import _direction_band, _wrapped_with_breaks
 
 # a full-size maneuvers summary shape: every profile at every flight time

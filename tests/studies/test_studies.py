@@ -9,9 +9,9 @@ import re
 import pytest
 from pitotcal.studies import catalog
 from pitotcal.studies.catalog import STUDIES, StudyInterrupted, rerun, run_study
-from pitotcal.studies.common import percent
-from pitotcal.studies.runner import echo_task, read_table
-from pitotcal.studies.study import MonteCarloStudy, Study
+from pitotcal.studies.engine.common import percent
+from pitotcal.studies.engine.runner import echo_task, read_table
+from pitotcal.studies.engine.study import MonteCarloStudy, Study
 
 BASE_COLUMNS = {"run_index", "seed", "error", "elapsed_s"}
 SCORE_COLUMNS = {"success", "n_samples", "k1", "k1_std", "k1_std_plain", "k1_true", "k1_err",

@@ -114,7 +114,7 @@ _BUDGET_FLAGS = (
 
 def _budget_inputs(args):
     from pitotcal.core.checks import number
-    from pitotcal.estimation.uncertainty.budget import inputs_from_options
+    from pitotcal.estimation.identification.budget import inputs_from_options
 
     scale = number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0)
     if args.u_rh_percent is not None:
@@ -135,7 +135,7 @@ def run(args):
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
     from pitotcal.estimation import identify
-    from pitotcal.estimation.uncertainty.budget import uncertainty_budget
+    from pitotcal.estimation.identification.budget import uncertainty_budget
     from pitotcal.estimation.reporting.budget_tables import budget_summary
     from pitotcal.io import is_log_file
 

@@ -7,7 +7,7 @@ import json
 
 import numpy as np
 import pytest
-from pitotcal.estimation.uncertainty import budget as bd
+from pitotcal.estimation.identification import budget as bd
 from pitotcal.estimation import identify
 from pitotcal.maneuvers.fly.options import AirSensors
 from pitotcal.maneuvers.fly.simulator import simulate

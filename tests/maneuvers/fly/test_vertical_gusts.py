@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 from pitotcal.maneuvers.fly.simulator import simulate
-from pitotcal.maneuvers.fly.turbulence import LIFT_SLOPE_PER_RAD, WING_LOADING_NPM2, plunge_response
+from pitotcal.maneuvers.turbulence import LIFT_SLOPE_PER_RAD, WING_LOADING_NPM2, plunge_response
 from plans import circle_plan
 
 from pitotcal.core.errors import PitotcalError

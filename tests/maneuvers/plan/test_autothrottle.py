@@ -119,9 +119,9 @@ def test_numpy_tuning_agrees_with_python_control(trim, options):
 
 def _check_with_python_control(plan, turbulence_mps, seed, rate_hz=10.0):
     """CAS (m/s) of the linear loop by superposition of python-control forced responses, with
-    the gust of maneuvers.fly.turbulence.dryden_gusts (the check's implementation before numpy)."""
+    the gust of maneuvers.turbulence.dryden_gusts (the check's implementation before numpy)."""
     import control
-    from pitotcal.maneuvers.fly.turbulence import dryden_gusts, dryden_scales
+    from pitotcal.maneuvers.turbulence import dryden_gusts, dryden_scales
 
     t = np.arange(plan.time_s[0], plan.time_s[-1] + 0.5 / rate_hz, 1.0 / rate_hz)
     tas_ref = np.interp(t, plan.time_s, plan.tas_mps)

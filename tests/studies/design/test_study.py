@@ -48,7 +48,7 @@ def test_emulated_bound_is_the_plain_covariance_for_white_noise():
     plain s^2 (J^T J)^-1, s^2 the mean of the white variances (transducer and GPS noise through
     the wind sensitivities) on the emulator's 0.2-s grid: its reported bound, within 1%."""
     import numpy as np
-    from pitotcal.studies.common import get_plan
+    from pitotcal.studies.engine.common import get_plan
     from pitotcal.studies.design.reported import emulated_reported_kt
 
     from pitotcal.core.information import delta_v_band_kt, qci_sensitivities

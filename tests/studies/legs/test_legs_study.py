@@ -5,7 +5,7 @@ import re
 
 import pytest
 from pitotcal.studies.catalog import STUDIES, rerun, run_study
-from pitotcal.studies.runner import read_table
+from pitotcal.studies.engine.runner import read_table
 
 HEADLINE = (r"scatter: global ΔV ±\d\.\d\d kt vs per point ±\d+\.\d\d kt \(median 95 % "
             r"half-widths\), coverage global \S+%, per point \S+%; stated: .+")

@@ -119,7 +119,7 @@ def test_compare_peers_inverse_truth_case(tmp_path):
     """The second truth case (the paper's inverse+ model): pitotcal fits `inverse`, the peers
     their single scale; both cases in one table, one summary, two figures."""
     from pitotcal.studies.catalog import run_study
-    from pitotcal.studies.runner import read_table
+    from pitotcal.studies.engine.runner import read_table
 
     from pitotcal.core.scenario import TRUE_K
 

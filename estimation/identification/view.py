@@ -19,7 +19,7 @@ from pitotcal.core.models import get_model
 from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, m_to_ft, mps_to_kt
 from pitotcal.io.jsonfile import json_ready
 
-from ..identification.static_source import (
+from .static_source import (
     air_data_lines,
     plot_altimeter_correction,
     plot_static_error,

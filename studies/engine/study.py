@@ -2,7 +2,7 @@
 the Monte Carlo kind (all but `real-alfa`).
 
 A study *collects* the rows of its table (running its runs; Ctrl-C stops it with
-`studies.runner.RunsInterrupted` carrying the finished ones), then *reports*: its summary and its
+`studies.engine.runner.RunsInterrupted` carrying the finished ones), then *reports*: its summary and its
 figures from those rows. `studies.catalog.run_study` does the rest for every study alike: the
 output folder, the table, the common summary keys, the headline, the JSON.
 """
@@ -29,7 +29,7 @@ class StudySettings:
     quick : bool
         A small grid for tests and smoke runs.
     workers, scheduler, progress :
-        Where the runs go (`studies.runner.run_cases`).
+        Where the runs go (`studies.engine.runner.run_cases`).
     data_dir : str or None
         Folder of real flight data (`real-alfa`; see `pitotcal.io.alfa.find_alfa_data`).
     engine : str

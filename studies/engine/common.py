@@ -182,7 +182,7 @@ def run_fly_identify(seed, plan=None, sim=None, model="inverse", seconds=None):
 
 def ok_rows(rows):
     """The rows of runs that finished (no error) and whose solver converged."""
-    # "True" as text: rows read back from a CSV (studies.runner.read_table)
+    # "True" as text: rows read back from a CSV (studies.engine.runner.read_table)
     return [r for r in rows if not r.get("error") and r.get("success", True) in (True, "True")]
 
 

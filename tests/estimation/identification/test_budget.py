@@ -1,11 +1,11 @@
-"""The uncertainty budget (estimation.uncertainty.budget): each term against a finite-difference re-solve
+"""The uncertainty budget (estimation.identification.budget): each term against a finite-difference re-solve
 and against its first-order formula; the combination and the JSON list."""
 
 import dataclasses
 
 import numpy as np
 import pytest
-from pitotcal.estimation.uncertainty import budget as bd
+from pitotcal.estimation.identification import budget as bd
 from pitotcal.estimation import identify
 from synthetic import synthetic_flight
 

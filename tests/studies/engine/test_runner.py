@@ -4,7 +4,7 @@ import contextlib
 import math
 
 import pytest
-from pitotcal.studies.runner import (
+from pitotcal.studies.engine.runner import (
     SERIAL_BELOW,
     RunsInterrupted,
     echo_task,
@@ -116,7 +116,7 @@ def not_dask_port():
 
 
 def test_a_port_that_is_not_dask_is_one_line_error_not_a_hang(not_dask_port, monkeypatch):
-    from pitotcal.studies import runner
+    from pitotcal.studies.engine import runner
 
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1.0)
     address = f"tcp://127.0.0.1:{not_dask_port}"

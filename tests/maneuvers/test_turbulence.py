@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from pitotcal.maneuvers.fly.turbulence import (
+from pitotcal.maneuvers.turbulence import (
     along_path_gust,
     dryden_filters,
     dryden_gusts,
