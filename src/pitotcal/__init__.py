@@ -28,6 +28,7 @@ _EXPORTS = {
     "write_plan": "pitotcal.io",
     "plan_maneuver": "pitotcal.maneuvers",
     "simulate": "pitotcal.maneuvers",
+    "SimulationOptions": "pitotcal.maneuvers",
     "Flight": "pitotcal.core.flight",
     "Plan": "pitotcal.core.plan",
     "MODELS": "pitotcal.core.models",
