@@ -1,7 +1,8 @@
 """pitotcal.maneuvers: planning a calibration maneuver and flying it in simulation.
 
 Planning: `profiles` (the q(t) schedules), `ocp` (the lateral-path optimal-control problem),
-`planner` (`plan_maneuver`), `outputs` (plan CSV companions: pilot card, setpoints, figure),
+`request` (`PlanRequest`, what to plan), `planner` (`plan_maneuver(PlanRequest(...))`),
+`outputs` (plan CSV companions: pilot card, setpoints, figure),
 `missions` (the plan as an autopilot mission: loiter circles and speed changes), `design`
 (information-optimal speed schedules, `plan_maneuver(design="optimal")`), `card` (pilot-card
 parts and picture).
@@ -30,6 +31,7 @@ _EXPORTS = {
     "export_mission": ".plan.missions",
     "loiter_plan": ".plan.missions",
     "plan_maneuver": ".plan.planner",
+    "PlanRequest": ".plan.request",
     "DesignOptions": ".plan.design_request",
     "predict_plan_band_kt": ".plan.design",
     "simulate": ".fly.simulator",

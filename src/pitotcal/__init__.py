@@ -27,6 +27,7 @@ _EXPORTS = {
     "read_plan": "pitotcal.io",
     "write_plan": "pitotcal.io",
     "plan_maneuver": "pitotcal.maneuvers",
+    "PlanRequest": "pitotcal.maneuvers",
     "simulate": "pitotcal.maneuvers",
     "SimulationOptions": "pitotcal.maneuvers",
     "Flight": "pitotcal.core.flight",
