@@ -17,7 +17,7 @@ from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.geo import check_lat_lon
 from pitotcal.core.models import MODELS, get_model
-from pitotcal.core.scenario import T2_PLAN, true_k
+from pitotcal.core.scenario import GPS_NOISE_MAX_MPS, T2_PLAN, true_k
 
 from .flyable import MAX_SAMPLES, MIN_SAMPLES, check_plan, check_pressure_error, check_samples
 
@@ -38,7 +38,7 @@ SIM_LIMITS = {
     "qc_scale_error": (0.5, "a gain error beyond 50 % is a broken sensor"),
     "pneumatic_lag_s": (5.0, "pitot tubing lags 0.01-0.5 s; seconds is a blocked line"),
     "gps_rate_hz": (100.0, "GNSS receivers update at 1-50 Hz"),
-    "gps_noise_mps": (10.0, "receivers report 0.02-0.5 m/s RMS"),
+    "gps_noise_mps": (GPS_NOISE_MAX_MPS, "receivers report 0.02-0.5 m/s RMS"),
     "gps_gm_sigma_mps": (5.0, "a receiver's slowly drifting velocity error is cm/s to dm/s"),
 }
 
