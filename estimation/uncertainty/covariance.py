@@ -172,7 +172,7 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
         a_inv = np.linalg.inv(instruments.T @ jac if information is None else information)
         cov = a_inv @ (0.5 * (middle + middle.T)) @ a_inv.T
     # The noise model is fitted to one record: its long-run variance has few degrees of
-    # freedom (T / (4 tau) for one exponential, `noise_model.DOF_TAUS`): Student-t widening.
+    # freedom (T / (4 tau) for one exponential, `DOF_TAUS`): Student-t widening.
     cov = cov * student_t_widening(dof) ** 2
     return ColoredCovariance(cov, lag, window, a, _few_stretches(residuals), dof)
 

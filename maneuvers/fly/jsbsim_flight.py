@@ -14,8 +14,8 @@ from .jsbsim_engine import (
     DEFAULT_CENTER_DEG,
     GAINS,
     JSBSIM_RATE_HZ,
-    fly,
     new_fdm,
+    run_closed_loop,
     set_turbulence,
     start,
 )
@@ -72,7 +72,7 @@ def simulate_jsbsim(plan, *, seed=0, aircraft=DEFAULT_AIRCRAFT, center_deg=None,
         fdm = new_fdm(aircraft, refs.dt_s / steps, scratch)
         trim = start(fdm, plan, refs, opts, center_deg, alt_agl_m)
         sigma = set_turbulence(fdm, opts, alt_agl_m, seed)
-        record, path_index = fly(fdm, refs, limits, opts, trim, center_deg, steps)
+        record, path_index = run_closed_loop(fdm, refs, limits, opts, trim, center_deg, steps)
         del fdm                             # closes its output file before the folder goes
     return _outputs(plan, refs, opts, seed, record, path_index,
                     {"engine": "jsbsim", "aircraft": aircraft, "milspec_sigma_mps": sigma,

@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from .guidance import GUIDANCE_GAINS, fly
+from .guidance import GUIDANCE_GAINS, integrate_closed_loop
 from ..plan.autothrottle import tune_autothrottle
 from .sensors import (
     air_records,
@@ -384,7 +384,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
     wind = wind_field(plan, refs, opts, rng_turb)
     if speed_loop is None:
         speed_loop = tune_autothrottle(0.5 * float(plan.tas_mps.min() + plan.tas_mps.max()))
-    states, path_index = fly(refs, wind, speed_loop, limits)
+    states, path_index = integrate_closed_loop(refs, wind, speed_loop, limits)
     states, w_up = _plunge(refs, wind, states, opts)
     flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps, w_up)
     tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)

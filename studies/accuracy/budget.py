@@ -12,7 +12,7 @@ a Monte Carlo of our own simulator shows; the Type B terms are what it cannot.
 
 import numpy as np
 
-from ..engine.common import fly, group, identify_flight, score, truth_for
+from ..engine.common import get_flight, group, identify_flight, score, truth_for
 from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
 
@@ -28,7 +28,7 @@ def task(seed, turbulence_mps):
     """One flight: its score against truth, and the budget's terms (max over V_i), kt."""
     from pitotcal.estimation.identification.budget import BudgetInputs, uncertainty_budget
 
-    flight, truth = fly(None, {"turbulence_mps": turbulence_mps, "air_data": "compressible"},
+    flight, truth = get_flight(None, {"turbulence_mps": turbulence_mps, "air_data": "compressible"},
                         seed)
     result = identify_flight(flight)
     budget = uncertainty_budget(flight, result, BudgetInputs(probe_arm_m=PROBE_ARM_M))

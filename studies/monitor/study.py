@@ -16,7 +16,7 @@ import functools
 
 import numpy as np
 
-from ..engine.common import column, fly, group
+from ..engine.common import column, get_flight, group
 from ..engine.figures import new_figure, save
 from .baseline import fixed_threshold_alarms
 from ..engine.study import MonteCarloStudy
@@ -58,7 +58,7 @@ def calibration():
     from pitotcal.estimation import identify
     from pitotcal.estimation.monitor.model import Calibration
 
-    flight, _ = fly(None, {"turbulence_mps": 0.5}, CAL_SEED)
+    flight, _ = get_flight(None, {"turbulence_mps": 0.5}, CAL_SEED)
     return Calibration.from_result(identify(flight))
 
 
@@ -73,7 +73,7 @@ def task(seed, condition, faults):
     from pitotcal.maneuvers.fly.faults import Fault, apply_fault
 
     cal = calibration()
-    flight, truth = fly(None, _sim(condition), seed)
+    flight, truth = get_flight(None, _sim(condition), seed)
     base = {"condition": condition, "turbulence_mps": CONDITIONS[condition]["turbulence_mps"]}
     rows = []
     for rate in DESIGN_RATES:

@@ -291,7 +291,7 @@ def _write_json(path, result, flight, source, budget=None, gps_error=None, readi
     # `identify` may carry the reader's warnings already: add only those it does not have
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
-    out.update(_monitor_noise_model(result))
+    out.update(_monitor_block_stats(result))
     out.update(_gps_error_record(gps_error))
     if reading is not None:
         out["reading"] = reading
@@ -307,14 +307,14 @@ def _gps_error_record(gps_error):
                           "tau_s": gps_error["gps_error_tau_s"]}}
 
 
-def _monitor_noise_model(result):
+def _monitor_block_stats(result):
     """{"noise_model": ...}: the residuals' noise model that `pitotcal monitor` designs its
-    thresholds from (estimation.monitor.model.noise_model); {} for a record too short."""
+    thresholds from; {} for a record too short."""
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.estimation.monitor.model import noise_model
+    from pitotcal.estimation.monitor.model import block_residual_stats
 
     try:
-        return {"noise_model": noise_model(result)}
+        return {"noise_model": block_residual_stats(result)}
     except PitotcalError:
         return {}
 
