@@ -1,4 +1,4 @@
-"""The airspeed parameter an autopilot should load, from a calibration flight (issue 10).
+"""The airspeed parameter an autopilot should load, from a calibration flight.
 
 Derivation. Both autopilots turn the sensor's differential pressure Δp (offset removed; the
 q_ci pitotcal reads from the log, ArduPilot ``ARSP.DiffPress``, PX4 ``differential_pressure``)

@@ -1,4 +1,4 @@
-"""The calibration report: one self-contained HTML file from a result JSON (issue 10).
+"""The calibration report: one self-contained HTML file from a result JSON.
 
 `build_report` gathers what the template shows (title block, test conditions, method, the
 correction tables, figures as base64 PNG, warnings, compliance, legs, provenance, signatures);

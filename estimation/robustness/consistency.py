@@ -1,4 +1,4 @@
-"""Consistency of the calibration over the flight (issue 15, item 2): a step-change test.
+"""Consistency of the calibration over the flight: a step-change test.
 
 One calibration for the whole record is the model; a leak, an iced or blocked port or a
 drift that starts mid-flight breaks it while the global fit stays tight, because the

@@ -1,4 +1,4 @@
-"""Abrupt level changes of q_ci (issue 15, item 2): a leak that opens at once.
+"""Abrupt level changes of q_ci: a leak that opens at once.
 
 A leak, a blocked port or a loose line that sets in at once moves q_ci by a few percent from
 one sample to the next and keeps it there. The fit bends its coefficients to the change of

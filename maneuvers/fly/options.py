@@ -24,7 +24,7 @@ __all__ = ["MAX_SAMPLES", "MIN_SAMPLES", "SIM_LIMITS", "AirSensors", "SimOptions
 MAX_SAMPLES = 500_000
 MIN_SAMPLES = 10          # the flight CSV reader's MIN_ROWS: fewer is no flight
 
-# Issue 15: upper bounds of the options, with the reason given when one is refused (the
+# Upper bounds of the options, with the reason given when one is refused (the
 # simulator would run, overflow or fill memory beyond them; nothing real lies there).
 # rate_hz is bounded by MAX_SAMPLES over the plan, gps_latency_s by the plan's length.
 SIM_LIMITS = {
@@ -88,10 +88,10 @@ class SimOptions:
     gps_latency_s: float
     air_data: str = "incompressible"
     air_sensors: "AirSensors | None" = None
-    # Gauss-Markov GPS velocity error (issue 11): steady-state sigma (m/s; 0 none), tau (s)
+    # Gauss-Markov GPS velocity error: steady-state sigma (m/s; 0 none), tau (s)
     gps_gm_sigma_mps: float = 0.0
     gps_gm_tau_s: float = 30.0
-    # Dryden's vertical gust flown (issue 11): plunge, altitude, GPS climb and V_t
+    # Dryden's vertical gust flown: plunge, altitude, GPS climb and V_t
     vertical_gusts: bool = False
 
     def to_dict(self):
@@ -111,7 +111,7 @@ class SimOptions:
 
 @dataclass(frozen=True)
 class AirSensors:
-    """Air-data sensors and effects of the issue 9 budget (maneuvers.fly.sensors.air_records).
+    """Air-data sensors and the effects the uncertainty budget counts (sensors.air_records).
 
     Attributes
     ----------
@@ -179,7 +179,7 @@ def check_plan(plan):
         raise PitotcalError("plan airspeeds must be > 0")
 
 
-# Issue 15: the largest pressure error simulated, |dp/q_c| (beyond it the sensor would read
+# The largest pressure error simulated, |dp/q_c| (beyond it the sensor would read
 # zero or negative impact pressure: no pitot-static system).
 MAX_PRESSURE_ERROR = 0.5
 

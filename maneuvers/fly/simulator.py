@@ -213,7 +213,7 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
     else:
         qc = impact_pressure_pa(rho, v_air ** 2)
     air = {}
-    if opts.air_sensors is not None:      # issue 9 item 7: temperature, humidity, probe arm
+    if opts.air_sensors is not None:      # temperature, humidity, probe arm
         qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
                                    opts.k)
     climb = np.gradient(alt, dt) if n > 1 else np.zeros(n)
@@ -354,14 +354,14 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         also carry `ps_pa` (the static port: p_s + q_c − q_ci) and `oat_k`.
     gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts : float, float, bool
         Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s);
-        fly Dryden's vertical gust too (`_plunge`; False: as before).
+        fly Dryden's vertical gust too (`_plunge`; False: horizontal gusts only).
     limits : pitotcal.core.dynamics.Limits, optional
         Default: Limits with the plan's bank_max_deg.
     speed_loop : maneuvers.plan.autothrottle.SpeedLoop, optional
         Default: tuned at the plan's mid-range true airspeed.
     keep_history : bool
         Also keep the true time histories in truth.history (not written to the truth JSON).
-    air_sensors : maneuvers.fly.options.AirSensors or dict, optional (issue 9; None: as before)
+    air_sensors : maneuvers.fly.options.AirSensors or dict, optional (None: no air-data sensors)
 
     Returns
     -------

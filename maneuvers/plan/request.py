@@ -21,7 +21,7 @@ log = logging.getLogger(__name__)
 # IPOPT's time grows a little faster than the node count (measured: 240 nodes 0.2 s, 1,200 6 s,
 # 2,400 19 s, 24,000 more than 5 min); beyond this a plan is refused with the dt_s that works.
 MAX_NODES = 3000
-# Issue 15: the longest maneuver planned, s (4 h).
+# The longest maneuver planned, s (4 h).
 MAX_DURATION_S = 14400.0
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""`leak`: is a leak from mid-flight flagged, and does a clean flight stay quiet? (issue 15, item 2)
+"""`leak`: is a leak from mid-flight flagged, and does a clean flight stay quiet?
 
 Every run flies a maneuver (the T-2 one-way speed sweep, or the same flown up and back down
 the speeds, `plan --return`) in calm air or in turbulence, with or without a leak in the total

@@ -1,4 +1,4 @@
-"""`design` (issue 13): the information-optimal speed schedule against the best paper profile.
+"""`design`: the information-optimal speed schedule against the best paper profile.
 
 Two-speed (the best of the paper's profiles in the `maneuvers` study) is flown for 240 s; the
 optimal design (`plan --design optimal`, with its check level, and without it) at several

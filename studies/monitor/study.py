@@ -37,7 +37,7 @@ CONDITIONS = {
 }
 FAULT_CONDITIONS = ("calm", "turb-0.5", "turb-1.0")
 # clean-only flights per condition per run of the grid: at 30 runs, 210 flights and 12.25
-# monitored hours per condition (the issue asks for < 1 false alarm per 10 flight-hours)
+# monitored hours per condition (the target: < 1 false alarm per 10 flight-hours)
 EXTRA_CLEAN = 6
 # (kind, size, the classification that is right for it)
 FAULTS = (("blocked", 0.0, "frozen"), ("blocked", 3.0, "drain"),

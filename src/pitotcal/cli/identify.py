@@ -28,14 +28,14 @@ def add_parser(subparsers):
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
-    # --- air data (issue 9) ---
+    # --- air data ---
     p.add_argument("--air", default="compressible", metavar="MODE",
                    help="how impact pressure follows from true airspeed: compressible "
                         "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
                         "all pressure error taken in the static source, or separated with "
                         "a ps_ref_pa reference column; V_i, V_c standard CAS) or "
                         "incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
-                        "paper's eq. 2 and the results before issue 9); a flight without "
+                        "paper's eq. 2; needs no static port); a flight without "
                         "ps_pa/oat_k is fitted incompressible with a warning; default "
                         "%(default)s")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
@@ -45,7 +45,7 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
-    # issue 10: the airspeed parameter an autopilot loads (logic in estimation/autopilot.py)
+    # the airspeed parameter an autopilot loads (estimation.reporting.autopilot_params)
     g = p.add_argument_group("autopilot parameters")
     g.add_argument("--params", metavar="OUT", default=None,
                    help="write the recommended airspeed parameter: for an ArduPilot log a "
@@ -64,7 +64,7 @@ def add_parser(subparsers):
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
     _add_budget_arguments(p)
-    # --- issue 11: the GPS receiver's time-correlated velocity error, stated ---
+    # --- the GPS receiver's time-correlated velocity error, stated ---
     gps = p.add_argument_group("GPS velocity error (a known term of the bounds)")
     gps.add_argument("--gps-error-sigma-mps", type=float, default=None, metavar="SIGMA",
                      help="the GPS receiver's slowly varying velocity error per component, "
@@ -77,7 +77,7 @@ def add_parser(subparsers):
 
 
 def _add_budget_arguments(p):
-    """Issue 9 items 4-5: temperature/humidity inputs and the uncertainty budget's overrides."""
+    """Temperature/humidity inputs and the uncertainty budget's overrides."""
     air = p.add_argument_group("temperature and humidity")
     air.add_argument("--temp-recovery", type=float, default=1.0, metavar="R",
                      help="recovery factor of the total-temperature probe of a tat_k column, "
@@ -154,7 +154,7 @@ def run(args):
                       gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))
     budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
 
-    # issue 15: every file is written before anything is printed, so a reader that goes
+    # every file is written before anything is printed, so a reader that goes
     # away early (`| head`) never costs a file
     if args.json is not None:
         _write_json(args.json, result, flight, source, budget, _gps_error(args), _reading(args))
@@ -164,7 +164,7 @@ def run(args):
     if args.params is not None:
         try:
             params = _write_params(args, flight, autopilot, current)
-        except PitotcalError as exc:        # said after the summary, as before
+        except PitotcalError as exc:        # said after the summary
             refused = exc
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
@@ -299,7 +299,7 @@ def _write_json(path, result, flight, source, budget=None, gps_error=None, readi
 
 
 def _gps_error_record(gps_error):
-    """JSON "gps_error": the stated GPS error the bounds count (issue 11), or nothing."""
+    """JSON "gps_error": the stated GPS error the bounds count, or nothing."""
     if gps_error is None:
         return {}
     return {"gps_error": {"stated": gps_error["gps_error_sigma_mps"] is not None,

@@ -241,7 +241,7 @@ def _calibration(path):
                             f"parameters.k*.value needed; {type(exc).__name__}: {exc})") from None
     if not all(abs(v) < float("inf") for v in k):
         raise PitotcalError(f"--calibration {path}: coefficients must be finite, got {k}")
-    air = result.get("air_data", "incompressible")   # results before issue 9: incompressible
+    air = result.get("air_data", "incompressible")   # a result without air_data: incompressible
     if air not in ("compressible", "incompressible"):
         raise PitotcalError(f"--calibration {path}: air_data {air!r} is not compressible or "
                             "incompressible")

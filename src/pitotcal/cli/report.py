@@ -1,4 +1,4 @@
-"""`pitotcal report`: the calibration report, one self-contained HTML file (issue 10).
+"""`pitotcal report`: the calibration report, one self-contained HTML file.
 
 Exit status: 0 written; 2 unusable input (result JSON, flight, aircraft TOML, options), one
 stderr line naming the file or flag.

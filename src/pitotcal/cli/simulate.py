@@ -42,7 +42,7 @@ def add_parser(subparsers):
                    help="time-correlated (Gauss-Markov) GPS velocity error std, m/s (0: none)")
     s.add_argument("--gps-gm-tau-s", type=float, default=30.0,
                    help="its correlation time, s (30)")
-    # issue 11: Dryden's vertical gust flown (plunge, altitude, GPS climb, V_t)
+    # Dryden's vertical gust flown (plunge, altitude, GPS climb, V_t)
     s.add_argument("--vertical-gusts", action="store_true",
                    help="fly the vertical gust too: the aircraft plunges with it and the "
                         "airspeed includes the air-relative climb (own engine; JSBSim's "
@@ -57,14 +57,14 @@ def add_parser(subparsers):
                         "six-degree-of-freedom model, its atmosphere and Milspec turbulence")
     e.add_argument("--aircraft", default=None,
                    help="JSBSim aircraft (default c172x, the Cessna 172); --engine jsbsim only")
-    f = p.add_argument_group("fault (maneuvers.fly.faults)")
+    f = p.add_argument_group("fault (a sensor failure injected into the flight)")
     f.add_argument("--fault", metavar="KIND:ONSET_S:SIZE", default=None,
                    help="spoil the pitot-static record from ONSET_S on: blocked (SIZE drain "
                         "time constant s, 0 frozen), static (SIZE s, 0 sealed), leak (SIZE "
                         "fraction low), icing (SIZE kt/min), water (SIZE fraction); the truth "
                         "JSON gets \"fault\"")
     a = p.add_argument_group(
-        "air-data sensors (issue 9)",
+        "air-data sensors",
         "with any of these the flight also logs ps_pa, oat_k or tat_k, and rh_pct")
     a.add_argument("--tat-recovery", type=float, default=None, metavar="R",
                    help="log a total-temperature probe of recovery factor R (tat_k) instead of "
@@ -96,7 +96,7 @@ def _air_sensor_option(args):
 
 
 def _air_sensors(args):
-    """The `air_sensors` dict of the options given, or None (then the files are as before)."""
+    """The `air_sensors` dict of the options given, or None (no air-data sensors simulated)."""
     given = {"tat_recovery": args.tat_recovery, "rh_pct": args.rh_percent,
              "probe_arm_m": args.probe_arm_m, "oat_bias_k": args.oat_bias_k,
              "gps_bias_mps": None if args.gps_bias_mps is None else tuple(args.gps_bias_mps)}

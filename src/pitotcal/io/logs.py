@@ -224,7 +224,7 @@ def _assemble(s, name, start_s, end_s, opt):
             f"q_ci < {opt.min_q:g} Pa": q < opt.min_q}
     cuts.update(slow)
     cuts["non-finite density"] = ~np.isfinite(rho) | (rho <= 0)
-    # issue 15: a logger glitch (1e200 in a GPS velocity) is cut, never fitted
+    # a logger glitch (1e200 in a GPS velocity) is cut, never fitted
     cuts["implausible value"], glitch = implausible_samples(
         name, t, qc_pa=q, gps_vn_mps=gps.vn, gps_ve_mps=gps.ve, rho_kgm3=rho,
         gps_vd_mps=gps.vd if s.gps_vd is not None else None)
