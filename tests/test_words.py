@@ -44,3 +44,73 @@ def test_help_has_no_history_and_no_module_paths(command):
     assert "usage:" in text
     assert not HISTORY.search(text), HISTORY.search(text)
     assert not MODULE_PATH.search(text), MODULE_PATH.search(text)
+
+
+def _flat(text):
+    return " ".join(text.split())
+
+
+def _constants():
+    """(command, words its --help must contain), the numbers from the library's constants."""
+    import inspect
+
+    from pitotcal.core.dynamics import Limits
+    from pitotcal.estimation.identification import budget
+    from pitotcal.estimation.legs.flight import DETECT_DEFAULTS, POINT_TOL_KT
+    from pitotcal.estimation.legs.global_fit import BAND_FT
+    from pitotcal.io.alfa import ALFA_DATA_ENV, ALFA_DIR_NAME
+    from pitotcal.maneuvers.fly.jsbsim_engine import DEFAULT_AIRCRAFT
+    from pitotcal.maneuvers.fly.simulator import simulate
+    from pitotcal.maneuvers.plan.design import STALL_DEFAULT_RATIO
+    from pitotcal.maneuvers.plan.design_request import DesignOptions
+    from pitotcal.maneuvers.plan.planner import MAX_ITER, plan_maneuver
+    from pitotcal.studies.demo import DEMO_SIM
+
+    b, d = budget.BudgetInputs(), DesignOptions()
+    return [
+        ("identify", f"else {budget.RH_U_UNKNOWN_PCT:.0f} (dry assumed"),
+        ("identify", f"default {budget.RH_U_GIVEN_PCT:g} with a humidity"),
+        ("identify", f"up to {2 * len(budget.SOURCES)} extra solves"),
+        ("identify", f"static air temperature, K; default {b.u_oat_k:g}"),
+        ("identify", f"bias per axis, m/s; default {b.u_gps_velocity_mps:g}"),
+        ("identify", f"time alignment, s; default {b.u_gps_latency_s:g}"),
+        ("identify", f"V_t - r y; default {b.probe_arm_m:g}"),
+        ("identify", f"% of reading; default {100 * b.u_qc_scale:g}"),
+        ("identify", f"zero offset, Pa; default {b.u_qc_offset_pa:g}"),
+        *[("legs", f"(default: {value:g})") for value in DETECT_DEFAULTS.values()],
+        ("legs", f"form one point (default {POINT_TOL_KT:g})"),
+        ("legs", f"one wind per {BAND_FT:,.0f} ft"),
+        ("plan", f"roll-rate limit (default: {Limits().roll_rate_max_dps:g})"),
+        ("plan", f"acceleration limit (default: {Limits().accel_max_mps2:g})"),
+        ("plan", "step-pause levels (default: "
+                 f"{inspect.signature(plan_maneuver).parameters['levels'].default})"),
+        ("plan", f"iteration limit (default: {MAX_ITER})"),
+        ("plan", f"--cas-min-kt / {STALL_DEFAULT_RATIO:g})"),
+        ("plan", f"(default: {d.turbulence_mps:g})"),
+        ("plan", f"(default: {d.criterion})"),
+        ("plan", f"limits the bank (default: {d.stall_margin:g})"),
+        ("plan", f"(default: {d.check_fraction:g}; 0: two speeds only)"),
+        ("demo", f"the demo's {DEMO_SIM['rate_hz']:g})"),
+        ("simulate", f"default {inspect.signature(simulate).parameters['air_data'].default};"),
+        ("simulate", f"(default {DEFAULT_AIRCRAFT})"),
+        ("study", f"${ALFA_DATA_ENV}, else ./{ALFA_DIR_NAME}"),
+        ("study", f"JSBSim's {DEFAULT_AIRCRAFT};"),
+    ]
+
+
+def test_help_quotes_the_library_constants():
+    texts = {name: _flat(text) for name, text in help_texts().items()}
+    missing = [(command, words) for command, words in _constants()
+               if words not in texts[command]]
+    assert not missing, missing
+    assert "else 29" not in texts["identify"]           # the 0-100 % rectangular u is 100/√3
+
+
+def test_help_fields_are_all_filled_and_stay_filled():
+    """No ``{name}`` field is left in any help, and a help shown twice is the same."""
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.dest == "command")  # noqa: SLF001
+    for name in COMMANDS:
+        first = sub.choices[name].format_help()
+        assert not re.search(r"\{[a-z_]+(?::[^}]*)?\}", first), (name, first)
+        assert sub.choices[name].format_help() == first, name

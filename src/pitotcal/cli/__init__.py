@@ -38,6 +38,27 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(2, f"{self.prog}: {message} (see {self.prog} --help)\n")
 
+    def help_from(self, constants):
+        """Fill the ``{name}`` fields of this parser's help texts from `constants()`, a
+        function returning {name: value}, when the help is shown: the texts quote the library's
+        own constants, and only ``--help`` imports the (numpy-heavy) modules holding them."""
+        self._help_constants = constants
+
+    def format_help(self):
+        constants = getattr(self, "_help_constants", None)
+        if constants is not None:
+            values = constants()
+            for action in self._actions:
+                if action.help and action.help is not argparse.SUPPRESS:
+                    action.help = action.help.format_map(values)
+            for group in self._action_groups:
+                if group.description:
+                    group.description = group.description.format_map(values)
+            if self.description:
+                self.description = self.description.format_map(values)
+            self._help_constants = None
+        return super().format_help()
+
 
 def build_parser():
     parser = _Parser(

@@ -59,7 +59,8 @@ def add_parser(subparsers):
                            "stream (udp:127.0.0.1:14550), show dV and its 2-sigma, and write "
                            "the final result when the stream stops (or on Ctrl-C)")
     live.add_argument("--idle-s", type=float, default=3.0, metavar="S",
-                      help="live: the stream has ended after S seconds without a message (3)")
+                      help="live: the stream has ended after S seconds without a message "
+                           "(default %(default)g)")
     live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
@@ -92,37 +93,56 @@ def _add_budget_arguments(p):
         "each given as a standard uncertainty and propagated by re-solving the perturbed "
         "flight; reported as the expanded uncertainty U (k = 2)")
     bud.add_argument("--no-budget", action="store_true",
-                     help="skip the budget (up to 14 extra solves)")
-    for flag, default, metavar, text in _BUDGET_FLAGS:
-        bud.add_argument(flag, type=float, default=default, metavar=metavar, help=text)
+                     help="skip the budget (up to {budget_solves} extra solves)")
+    for flag, metavar, text in _BUDGET_FLAGS:
+        bud.add_argument(flag, type=float, default=None, metavar=metavar, help=text)
+    p.help_from(_help_constants)
 
 
-# (flag, default, metavar, help); the defaults and their sources: estimation/budget.py
+# (flag, metavar, help); None leaves the budget's own default (BudgetInputs), which the help
+# quotes from there
 _BUDGET_FLAGS = (
-    ("--u-oat-k", 1.0, "K", "static air temperature, K; default %(default)s"),
-    ("--u-rh-percent", None, "PCT", ("relative humidity, %%RH; default 5 with a humidity, "
-                                     "else 29 (dry assumed, 0-100 %% rectangular)")),
-    ("--u-gps-velocity-mps", 0.05, "MPS", "GPS velocity bias per axis, m/s; default %(default)s"),
-    ("--u-gps-latency-s", 0.05, "S", "GPS-pressure time alignment, s; default %(default)s"),
-    ("--probe-arm-m", 0.0, "M", ("lateral offset of the pitot probe from the centre line, m "
-                                 "(right wing +): turns make it see V_t - r y; default "
-                                 "%(default)s")),
-    ("--u-qc-scale-percent", 0.1, "PCT", "transducer gain, %% of reading; default %(default)s"),
-    ("--u-qc-offset-pa", 1.0, "PA", "transducer zero offset, Pa; default %(default)s"),
+    ("--u-oat-k", "K", "static air temperature, K; default {u_oat_k:g}"),
+    ("--u-rh-percent", "PCT", ("relative humidity, %%RH; default {rh_given:g} with a humidity, "
+                               "else {rh_unknown:.0f} (dry assumed, 0-100 %% rectangular)")),
+    ("--u-gps-velocity-mps", "MPS", "GPS velocity bias per axis, m/s; default "
+                                    "{u_gps_velocity_mps:g}"),
+    ("--u-gps-latency-s", "S", "GPS-pressure time alignment, s; default {u_gps_latency_s:g}"),
+    ("--probe-arm-m", "M", ("lateral offset of the pitot probe from the centre line, m "
+                            "(right wing +): turns make it see V_t - r y; default "
+                            "{probe_arm_m:g}")),
+    ("--u-qc-scale-percent", "PCT", "transducer gain, %% of reading; default "
+                                    "{u_qc_scale_percent:g}"),
+    ("--u-qc-offset-pa", "PA", "transducer zero offset, Pa; default {u_qc_offset_pa:g}"),
 )
+
+
+def _help_constants():
+    """The library constants `identify --help` quotes."""
+    import dataclasses
+
+    from pitotcal.estimation.identification import budget
+
+    defaults = dataclasses.asdict(budget.BudgetInputs())
+    return {**defaults, "u_qc_scale_percent": 100.0 * defaults["u_qc_scale"],
+            "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
+            # each source re-solved at +u and -u
+            "budget_solves": 2 * len(budget.SOURCES)}
 
 
 def _budget_inputs(args):
     from pitotcal.core.checks import number
     from pitotcal.estimation.identification.budget import inputs_from_options
 
-    scale = number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0)
+    scale = args.u_qc_scale_percent
+    if scale is not None:
+        scale = number("u_qc_scale_percent", scale, 0.0, 100.0) / 100.0
     if args.u_rh_percent is not None:
         number("u_rh_percent", args.u_rh_percent, 0.0, 100.0)
     return inputs_from_options(
         u_oat_k=args.u_oat_k, u_rh_pct=args.u_rh_percent,
         u_gps_velocity_mps=args.u_gps_velocity_mps, u_gps_latency_s=args.u_gps_latency_s,
-        probe_arm_m=args.probe_arm_m, u_qc_scale=scale / 100.0,
+        probe_arm_m=args.probe_arm_m, u_qc_scale=scale,
         u_qc_offset_pa=args.u_qc_offset_pa)
 
 

@@ -31,7 +31,8 @@ def add_parser(subparsers):
                    help="write the figure (paper Fig. 15 style)")
     add_reading_arguments(p)
     p.add_argument("--idle-s", type=float, default=3.0, metavar="S",
-                   help="live: the stream has ended after S seconds without a message (3)")
+                   help="live: the stream has ended after S seconds without a message "
+                        "(default %(default)g)")
     t = p.add_argument_group("test design")
     t.add_argument("--false-alarms-per-hour", type=float, default=0.02, metavar="RATE",
                    help="designed false-alarm rate per flight hour (default %(default)s)")
