@@ -178,3 +178,19 @@ def test_convert_window_errors_name_the_flags(tmp_path, flight, capsys, args, ma
                  *args]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and re.search(match, err[0]), err
+
+
+@pytest.mark.parametrize("writer", [write_dataflash_bin, write_ulog])
+def test_convert_help_lists_the_columns_it_writes(tmp_path, flight, capsys, writer):
+    """`convert --help` lists the writer's columns of a log's flight: the 9 it writes."""
+    log = writer(tmp_path / ("f.bin" if writer is write_dataflash_bin else "f.ulg"), flight)
+    out = tmp_path / "f.csv"
+    assert main(["convert", str(log), "-o", str(out), "--oat-c", "15"]) == 0
+    header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
+    written = header.split(",")
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        main(["convert", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert len(written) == 9
+    assert f"flight CSV ({', '.join(written)};" in text

@@ -73,7 +73,8 @@ from .flight_checks import (
     window_text,
 )
 
-__all__ = ["PLAN_NOT_FLIGHT", "csv_kind", "read_flight_csv", "write_flight_csv"]
+__all__ = ["PLAN_NOT_FLIGHT", "WRITTEN_COLUMNS", "WRITTEN_OPTIONAL_COLUMNS", "csv_kind",
+           "read_flight_csv", "write_flight_csv"]
 
 PLAN_NOT_FLIGHT = ("this is a plan (the columns of pitotcal plan), not a flight: fly or simulate "
                    "it first (pitotcal simulate PLAN.csv -o FLIGHT.csv)")
@@ -84,9 +85,9 @@ def write_flight_csv(flight, path, comments=None):
 
     Density is written as `rho_kgm3`; the optional columns only when present.
     """
-    columns = ["time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3"]
+    columns = list(WRITTEN_COLUMNS)
     data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
-    for name in ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa", *TEMPERATURE_COLUMNS):
+    for name in WRITTEN_OPTIONAL_COLUMNS:
         if getattr(flight, name) is not None:
             columns.append(name)
             data.append(getattr(flight, name))
@@ -107,6 +108,11 @@ OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_ref_pa")
 STATIC_COLUMNS = ("ps_pa", "oat_k")
 # total air temperature and humidity, converted by core.moist_air
 TEMPERATURE_COLUMNS = ("tat_k", "rh_pct")
+# What `write_flight_csv` writes: these columns always, in this order, then those of the
+# optional ones (Flight fields of the same names) the flight has.
+WRITTEN_COLUMNS = (*REQUIRED_COLUMNS, "rho_kgm3")
+WRITTEN_OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa",
+                            *TEMPERATURE_COLUMNS)
 MIN_ROWS = 10
 
 

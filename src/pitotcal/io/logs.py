@@ -75,7 +75,11 @@ from .flightlog import AutopilotWind, FlightLog
 from .streams import LOG_EXTENSIONS
 from .timebase import apply_cuts, clean, gps_onto, spans
 
-__all__ = ["AutopilotWind", "FlightLog", "load_log", "read_log"]
+__all__ = ["LOG_COLUMNS", "AutopilotWind", "FlightLog", "load_log", "read_log"]
+
+# The optional flight columns a log's flight carries (`load_log`): the static pressure and its
+# temperature always, the GPS climb rate and altitude when the log records them.
+LOG_COLUMNS = ("ps_pa", "oat_k", "gps_vd_mps", "alt_m")
 
 log = logging.getLogger(__name__)
 
