@@ -49,9 +49,10 @@ def add_parser(subparsers):
     g = p.add_argument_group("autopilot parameters")
     g.add_argument("--params", metavar="OUT", default=None,
                    help="write the recommended airspeed parameter: for an ArduPilot log a "
-                        "Mission Planner / MAVProxy parameter file with ARSPD_RATIO, for a PX4 "
-                        "log a QGroundControl parameter file with ASPD_SCALE_1 (the current "
-                        "value and the 2-sigma as comments); exit 2 with the reason when the "
+                        "Mission Planner / MAVProxy parameter file with {ardupilot_param}, for a "
+                        "PX4 log a QGroundControl parameter file with the scale parameter the log "
+                        "has ({px4_params}; {px4_param} when it has neither); the current "
+                        "value and the 2-sigma as comments; exit 2 with the reason when the "
                         "flight cannot support one")
     live = p.add_argument_group("live (a MAVLink stream instead of FLIGHT)")
     live.add_argument("--live", metavar="CONNECTION", default=None,
@@ -122,12 +123,15 @@ def _help_constants():
     import dataclasses
 
     from pitotcal.estimation.identification import budget
+    from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
     defaults = dataclasses.asdict(budget.BudgetInputs())
     return {**defaults, "u_qc_scale_percent": 100.0 * defaults["u_qc_scale"],
             "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
             # each source re-solved at +u and -u
-            "budget_solves": 2 * len(budget.SOURCES)}
+            "budget_solves": 2 * len(budget.SOURCES),
+            "ardupilot_param": ARDUPILOT_RATIO, "px4_params": " or ".join(PX4_SCALES),
+            "px4_param": PX4_SCALES[0]}
 
 
 def _budget_inputs(args):
@@ -266,10 +270,15 @@ def _write_plot(path, result, budget):
 
 def _write_params(args, flight, autopilot, current):
     """The recommended airspeed parameter, or a PitotcalError (exit 2) saying why not."""
-    from pitotcal.estimation.reporting.autopilot_params import PARAMETER, recommend, write_parameter_file
+    from pitotcal.estimation.reporting.autopilot_params import (
+        PARAMETER,
+        recommend,
+        write_parameter_file,
+    )
+    from pitotcal.io.param_files import PX4_SCALES
 
-    name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
-        if autopilot == "PX4" else None
+    # PX4: the scale parameter the log has (its name changed between releases)
+    name = next((n for n in PX4_SCALES if n in current), None) if autopilot == "PX4" else None
     rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
                     gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air,
                     **_gps_error(args))
