@@ -114,3 +114,63 @@ def test_help_fields_are_all_filled_and_stay_filled():
         first = sub.choices[name].format_help()
         assert not re.search(r"\{[a-z_]+(?::[^}]*)?\}", first), (name, first)
         assert sub.choices[name].format_help() == first, name
+
+
+# Strings of the library that may hold a command-line flag: a command line it runs or records,
+# and the commands a result file comes from.
+FLAG_STRINGS_ALLOWED = ("--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
+                        "--print-to-pdf=", "pitotcal simulate --engine jsbsim",
+                        "`pitotcal identify --json`", "`pitotcal legs --json`")
+FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]+")
+
+
+def _strings(path):
+    """The string constants of a module (f-string parts included), docstrings left out."""
+    import ast
+
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    docs = {id(node.body[0].value) for node in ast.walk(tree)
+            if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+            and node.body and isinstance(node.body[0], ast.Expr)
+            and isinstance(node.body[0].value, ast.Constant)}
+    return [node.value for node in ast.walk(tree) if isinstance(node, ast.Constant)
+            and isinstance(node.value, str) and id(node) not in docs]
+
+
+def test_library_messages_name_arguments_not_flags():
+    """A message of the library names the Python argument (`oat_k`); the command line shows
+    its flag (--oat-c): no flag in the library's strings outside `pitotcal.cli`."""
+    found = []
+    for path in _package_sources():
+        if "cli" in path.parts:
+            continue
+        for text in _strings(path):
+            rest = text
+            for allowed in FLAG_STRINGS_ALLOWED:
+                rest = rest.replace(allowed, "")
+            if FLAG.search(rest):
+                found.append(f"{path.name}: {text[:80]!r}")
+    assert not found, "\n".join(found)
+
+
+@pytest.mark.parametrize("argv, message, shown", [
+    (["report", "r.json", "-o", "r.html"], "`aircraft_path` a.toml: not valid TOML",
+     "--aircraft a.toml: not valid TOML"),
+    (["report", "r.json", "-o", "r.html"], "`pdf_path`: Chromium failed", "--pdf: Chromium failed"),
+    (["study", "coverage"], "`scheduler` 'tcp://x:1': cannot connect to a Dask scheduler",
+     "--scheduler 'tcp://x:1': cannot connect to a Dask scheduler"),
+    (["identify", "f.bin"], "not OAT (give the outside air temperature, `oat_k`)",
+     "not OAT (give the outside air temperature, --oat-c)"),
+    (["identify", "f.bin"], "calibrate it apart (`start_s`, `end_s`)",
+     "calibrate it apart (--start-s, --end-s)"),
+    # a command without that flag keeps the argument's name
+    (["plan", "-o", "p.csv"], "give `oat_k`", "give `oat_k`"),
+])
+def test_the_command_line_shows_flags_for_the_named_arguments(argv, message, shown):
+    from pitotcal.cli import flag_message
+    from pitotcal.core.errors import PitotcalError
+
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    assert flag_message(parser, args, PitotcalError(message)) == shown
+    assert flag_message(parser, args, UserWarning(message)) == shown

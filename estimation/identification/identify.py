@@ -264,7 +264,7 @@ def _air_data(flight, air):
     if air == "compressible" and (flight.ps_pa is None or flight.oat_k is None):
         return "incompressible", ((
             f"{flight.source}: no static pressure and temperature (ps_pa, oat_k): fitted with "
-            "the incompressible q_c = rho V_t^2 / 2 (as --air incompressible), so V_c and dV "
+            "the incompressible q_c = rho V_t^2 / 2 (`air` incompressible), so V_c and dV "
             "are sqrt(2 q / rho0), not the standard calibrated airspeed; give ps_pa and oat_k "
             "for the compressible calibration"),)
     return air, ()

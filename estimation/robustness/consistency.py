@@ -131,8 +131,8 @@ def hidden_warning(source, details):
             f"{hidden['dv_shift_kt']:.2f} kt at {hidden['vi_kt']:.0f} kt, "
             f"{hidden['dv_shift_kt'] / hidden['dv_2sigma_reported_kt']:.1f} times the 2-sigma "
             "band the result reports there; fly "
-            "the speeds twice (plan --return: up and back down the speed range) to tell the "
-            "two apart")
+            "the speeds twice (plan a return sweep: up and back down the speed range) to tell "
+            "the two apart")
 
 
 def _scan(jac, r, qci, first, threshold):

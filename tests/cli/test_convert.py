@@ -42,7 +42,7 @@ def test_convert_window_and_warning_lines(tmp_path, flight, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["warning: f.ulg: no outside air temperature in the log: density uses "
                    "differential_pressure.temperature (airspeed sensor), a sensor temperature, "
-                   "not OAT (pass oat_k, or --oat-c)"]
+                   "not OAT (give the outside air temperature, --oat-c)"]
     t = read_flight_csv(out).time_s
     assert t[0] >= 20.0 and t[-1] <= 80.0 and t.size == pytest.approx(600, abs=2)
 
@@ -84,9 +84,12 @@ def test_identify_reads_the_sitl_log_directly(shared_data, tmp_path, capsys):
     result = json.loads(out.read_text())
     assert result["converged"] and result["parameters"]["wind_speed_mps"]["value"] < 1.0
     warning = ("arduplane_sitl.log: no outside air temperature in the log: density uses "
-               "BARO.Temp (baro sensor), a sensor temperature, not OAT (pass oat_k, or --oat-c)")
+               "BARO.Temp (baro sensor), a sensor temperature, not OAT (give the outside air "
+               "temperature, `oat_k`)")
     cap = capsys.readouterr()
-    assert cap.err == f"warning: {warning}\n" and result["warnings"].count(warning) == 1
+    # the record names the Python argument, the command line its flag
+    assert cap.err == f"warning: {warning.replace('`oat_k`', '--oat-c')}\n"
+    assert result["warnings"].count(warning) == 1
     # the take-off and landing rolls are cut: the table starts at the slowest flight (19 kt,
     # ARSPD_FBW_MIN = 10 m/s), not at the 11 kt of the ground roll
     assert 19.0 < result["airspeed_correction"][0]["vi_kt"] < 19.5

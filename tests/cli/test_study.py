@@ -112,4 +112,4 @@ def test_runs_above_the_cap_are_refused_with_the_cap(capsys):
     assert main(["study", "coverage", "--runs", "100000000"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == ("pitotcal study: --runs 100000000 is more than one study takes (100000, "
-                   "held in memory): run several studies with different --seed")
+                   "held in memory): run several studies, each with its own --seed")

@@ -307,7 +307,7 @@ def _density(s, t, alt, oat_k):
         temp_source = f"{s.temp_source}: sensor temperature, not OAT"
         s.conversions.append(f"no outside air temperature in the log: density uses "
                              f"{s.temp_source}, a sensor temperature, not OAT "
-                             "(pass oat_k, or --oat-c)")
+                             "(give the outside air temperature, `oat_k`)")
     else:
         temp = isa_temperature_k(alt)
         temp_source = "ISA at GPS altitude (no temperature in the log)"

@@ -77,7 +77,7 @@ class MavlinkFlightBuffer:
             out.append(f"{self.source}: {self.n_out_of_order} out-of-order samples dropped")
         if self.rows and self.oat_k is None:
             out.append(f"{self.source}: density from the pressure sensor's own temperature "
-                       f"(not OAT; give --oat-c)")
+                       f"(not OAT; give the outside air temperature, `oat_k`)")
         return out
 
     def flight(self):
