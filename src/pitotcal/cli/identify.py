@@ -352,7 +352,7 @@ def _run_live(args):
     """`--live CONNECTION`: estimation.live.identify_stream, its updates on stderr."""
     import sys
 
-    from .common import check_outputs, oat_k_from_c
+    from .common import announce_stream, check_outputs, oat_k_from_c
     from pitotcal.core.checks import choice, positive
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -381,10 +381,11 @@ def _run_live(args):
               f"{fix.dv_kt:+6.2f} +/- {fix.dv_2sigma_kt:5.2f} kt (2 sigma)  "
               f"[{fix.update_s * 1000:4.0f} ms]{flag}", file=sys.stderr)
 
+    oat_k, idle_s = oat_k_from_c(args.oat_c), positive("idle_s", args.idle_s)
+    announce_stream("identify", args.live, idle_s)
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
-        oat_k=oat_k_from_c(args.oat_c), idle_timeout_s=positive("idle_s", args.idle_s),
-        on_fix=show, air=args.air, gps_error=_gps_error(args))
+        oat_k=oat_k, idle_timeout_s=idle_s, on_fix=show, air=args.air, gps_error=_gps_error(args))
     print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
     print(result.summary())

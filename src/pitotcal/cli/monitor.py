@@ -77,7 +77,7 @@ def run(args):
     import sys
     import warnings
 
-    from .common import check_outputs, oat_k_from_c
+    from .common import announce_stream, check_outputs, oat_k_from_c
     from pitotcal.core.checks import positive
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor.monitoring import monitor
@@ -96,8 +96,9 @@ def run(args):
                           warmup_s=args.warmup_s,
                           drift_kt_per_min=args.drift_kt_per_min).checked()
     if is_connection(args.source):
-        result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k_from_c(args.oat_c),
-                                     idle_timeout_s=positive("idle_s", args.idle_s),
+        oat_k, idle_s = oat_k_from_c(args.oat_c), positive("idle_s", args.idle_s)
+        announce_stream("monitor", args.source, idle_s)
+        result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k, idle_timeout_s=idle_s,
                                      on_status=lambda text: print(text, file=sys.stderr))
         flight = buf.flight()
         _check_warmup(flight, args.warmup_s)

@@ -25,9 +25,14 @@ from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.flight import Flight
 from pitotcal.core.units import density_kgm3
 
-__all__ = ["CONNECTION_PREFIXES", "MavlinkFlightBuffer", "is_connection", "read_stream"]
+__all__ = ["CONNECTION_PREFIXES", "FIRST_MESSAGE_TIMEOUT_S", "LISTENING_PREFIXES",
+           "MavlinkFlightBuffer", "is_connection", "read_stream"]
 
 CONNECTION_PREFIXES = ("udp:", "udpin:", "udpout:", "tcp:", "tcpin:")
+# pymavlink's connections that wait for the sender (the others connect to it)
+LISTENING_PREFIXES = ("udp:", "udpin:", "tcpin:")
+# How long a stream may take to send its first message, s, before reading gives up
+FIRST_MESSAGE_TIMEOUT_S = 30.0
 _MESSAGES = ["SCALED_PRESSURE", "GLOBAL_POSITION_INT"]
 _RECEIVE_BUFFER_BYTES = 8 << 20
 
@@ -110,8 +115,8 @@ def _connect(source):
     return conn
 
 
-def read_stream(source, *, oat_k=None, idle_timeout_s=3.0, first_timeout_s=30.0,
-                every_s=1.0, on_tick=None, max_s=None):
+def read_stream(source, *, oat_k=None, idle_timeout_s=3.0,
+                first_timeout_s=FIRST_MESSAGE_TIMEOUT_S, every_s=1.0, on_tick=None, max_s=None):
     """Read a MAVLink stream until it stops; the `MavlinkFlightBuffer` of what arrived.
 
     Parameters
