@@ -301,8 +301,7 @@ def write_pdf(html_path, pdf_path):
     browser = next((shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome")
                     if shutil.which(b)), None)
     if browser is None:
-        raise PitotcalError("`pdf_path`: printing the PDF needs Chromium on PATH (Debian: "
-                            "apt-get install chromium)")
+        raise PitotcalError("`pdf_path` needs Chromium on PATH (Debian: apt-get install chromium)")
     # printed to a temporary file beside it, renamed when whole (pitotcal.io.atomic)
     with atomic_path(pdf_path) as tmp:
         cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",

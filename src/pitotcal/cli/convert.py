@@ -29,10 +29,10 @@ def add_parser(subparsers):
 
 def _help_constants():
     """The columns `convert --help` lists: those the flight CSV writer writes of a log's flight."""
-    from pitotcal.io.flight_csv import WRITTEN_COLUMNS, WRITTEN_OPTIONAL_COLUMNS
+    from pitotcal.io.flight_csv import WRITTEN_COLUMNS, WRITTEN_IF_PRESENT
     from pitotcal.io.logs import LOG_COLUMNS
 
-    columns = [*WRITTEN_COLUMNS, *(c for c in WRITTEN_OPTIONAL_COLUMNS if c in LOG_COLUMNS)]
+    columns = [*WRITTEN_COLUMNS, *(c for c in WRITTEN_IF_PRESENT if c in LOG_COLUMNS)]
     return {"columns": ", ".join(columns)}
 
 

@@ -100,8 +100,7 @@ def _add_budget_arguments(p):
     p.help_from(_help_constants)
 
 
-# (flag, metavar, help); None leaves the budget's own default (BudgetInputs), which the help
-# quotes from there
+# (flag, metavar, help); the default None leaves BudgetInputs' own, which the help quotes
 _BUDGET_FLAGS = (
     ("--u-oat-k", "K", "static air temperature, K; default {u_oat_k:g}"),
     ("--u-rh-percent", "PCT", ("relative humidity, %%RH; default {rh_given:g} with a humidity, "
@@ -119,7 +118,8 @@ _BUDGET_FLAGS = (
 
 
 def _help_constants():
-    """The library constants `identify --help` quotes."""
+    """The library constants `identify --help` quotes (the budget re-solves each source at
+    +u and -u)."""
     import dataclasses
 
     from pitotcal.estimation.identification import budget
@@ -128,19 +128,16 @@ def _help_constants():
     defaults = dataclasses.asdict(budget.BudgetInputs())
     return {**defaults, "u_qc_scale_percent": 100.0 * defaults["u_qc_scale"],
             "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
-            # each source re-solved at +u and -u
-            "budget_solves": 2 * len(budget.SOURCES),
-            "ardupilot_param": ARDUPILOT_RATIO, "px4_params": " or ".join(PX4_SCALES),
-            "px4_param": PX4_SCALES[0]}
+            "budget_solves": 2 * len(budget.SOURCES), "ardupilot_param": ARDUPILOT_RATIO,
+            "px4_params": " or ".join(PX4_SCALES), "px4_param": PX4_SCALES[0]}
 
 
 def _budget_inputs(args):
     from pitotcal.core.checks import number
     from pitotcal.estimation.identification.budget import inputs_from_options
 
-    scale = args.u_qc_scale_percent
-    if scale is not None:
-        scale = number("u_qc_scale_percent", scale, 0.0, 100.0) / 100.0
+    scale = (None if args.u_qc_scale_percent is None
+             else number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0) / 100.0)
     if args.u_rh_percent is not None:
         number("u_rh_percent", args.u_rh_percent, 0.0, 100.0)
     return inputs_from_options(
@@ -270,19 +267,16 @@ def _write_plot(path, result, budget):
 
 def _write_params(args, flight, autopilot, current):
     """The recommended airspeed parameter, or a PitotcalError (exit 2) saying why not."""
-    from pitotcal.estimation.reporting.autopilot_params import (
-        PARAMETER,
-        recommend,
-        write_parameter_file,
-    )
+    from pitotcal.estimation.reporting import autopilot_params
     from pitotcal.io.param_files import PX4_SCALES
 
     # PX4: the scale parameter the log has (its name changed between releases)
     name = next((n for n in PX4_SCALES if n in current), None) if autopilot == "PX4" else None
-    rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
-                    gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air,
-                    **_gps_error(args))
-    write_parameter_file(rec, args.params)
+    default = autopilot_params.PARAMETER.get(autopilot, "")
+    rec = autopilot_params.recommend(flight, autopilot, current.get(name or default),
+                                     gps_noise_std_mps=args.gps_noise_mps, name=name,
+                                     air=args.air, **_gps_error(args))
+    autopilot_params.write_parameter_file(rec, args.params)
     return rec
 
 

@@ -37,7 +37,8 @@ def add_parser(subparsers):
                    help="turn direction; both: right and left orbits alternate from one "
                         "speed group to the next, so a probe lever-arm term averages out "
                         "(default: %(default)s)")
-    p.add_argument("--dt-s", type=float, default=1.0, help="plan node spacing, s (default: %(default)g)")
+    p.add_argument("--dt-s", type=float, default=1.0,
+                   help="plan node spacing, s (default: %(default)g)")
     p.add_argument("--max-iter", type=int, default=None, metavar="N",
                    help="IPOPT iteration limit (default: {max_iter})")
     p.add_argument("--no-figures", action="store_true", help="skip the PNG files")

@@ -24,20 +24,25 @@ def add_parser(subparsers):
                    help="mean wind FROM, deg true, 0-360 (default: the plan's)")
     g.add_argument("--wind-drift-n-mps2", type=float, default=0.0, help="wind drift north, m/s^2")
     g.add_argument("--wind-drift-e-mps2", type=float, default=0.0, help="wind drift east, m/s^2")
-    g.add_argument("--turbulence-mps", type=float, default=0.5, help="Dryden horizontal RMS (%(default)g)")
+    g.add_argument("--turbulence-mps", type=float, default=0.5,
+                   help="Dryden horizontal RMS (%(default)g)")
     g.add_argument("--turbulence-length-m", type=float, help="gust scale length (MIL-F-8785C)")
     s = p.add_argument_group("sensors")
     s.add_argument("--rate-hz", type=float, default=50.0, help="sample rate (%(default)g)")
-    s.add_argument("--qc-noise-pa", type=float, default=0.5, help="transducer noise std (%(default)g)")
-    s.add_argument("--qc-quantization-pa", type=float, default=0.0, help="converter step (%(default)g)")
+    s.add_argument("--qc-noise-pa", type=float, default=0.5,
+                   help="transducer noise std (%(default)g)")
+    s.add_argument("--qc-quantization-pa", type=float, default=0.0,
+                   help="converter step (%(default)g)")
     s.add_argument("--qc-bias-pa", type=float, default=0.0, help="transducer bias (%(default)g)")
-    s.add_argument("--qc-scale-error", type=float, default=0.0, help="relative gain error (%(default)g)")
+    s.add_argument("--qc-scale-error", type=float, default=0.0,
+                   help="relative gain error (%(default)g)")
     s.add_argument("--pneumatic-lag-s", type=float, default=0.0, help="tubing lag (%(default)g)")
     s.add_argument("--gps-rate-hz", type=float, default=5.0,
                    help="GPS update rate, 0 = every sample (%(default)g)")
     s.add_argument("--gps-noise-mps", type=float, default=0.05,
                    help="GPS velocity noise std (%(default)g)")
-    s.add_argument("--gps-latency-s", type=float, default=0.0, help="GPS velocity latency (%(default)g)")
+    s.add_argument("--gps-latency-s", type=float, default=0.0,
+                   help="GPS velocity latency (%(default)g)")
     s.add_argument("--gps-gm-sigma-mps", type=float, default=0.0,
                    help="time-correlated (Gauss-Markov) GPS velocity error std, m/s (0: none)")
     s.add_argument("--gps-gm-tau-s", type=float, default=30.0,

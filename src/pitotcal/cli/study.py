@@ -24,7 +24,8 @@ def add_parser(subparsers):
                    help="address of an existing Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--workers", type=int, default=None,
                    help="local worker processes (default: all cores; 0: run in this process)")
-    p.add_argument("--seed", type=int, default=0, help="base seed; run i uses the table's seed (default %(default)s)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="base seed; run i uses the table's seed (default %(default)s)")
     p.add_argument("--quick", action="store_true", help="small grid (smoke runs, CI)")
     p.add_argument("--data", dest="data_dir", default=None, metavar="DIR",
                    help="real-alfa: folder of the ALFA flight CSVs (default: "

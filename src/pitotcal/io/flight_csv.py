@@ -73,24 +73,19 @@ from .flight_checks import (
     window_text,
 )
 
-__all__ = ["PLAN_NOT_FLIGHT", "WRITTEN_COLUMNS", "WRITTEN_OPTIONAL_COLUMNS", "csv_kind",
-           "read_flight_csv", "write_flight_csv"]
+__all__ = ["PLAN_NOT_FLIGHT", "csv_kind", "read_flight_csv", "write_flight_csv"]
 
 PLAN_NOT_FLIGHT = ("this is a plan (the columns of pitotcal plan), not a flight: fly or simulate "
                    "it first (pitotcal simulate PLAN.csv -o FLIGHT.csv)")
 
 
 def write_flight_csv(flight, path, comments=None):
-    """Write `flight` as a flight CSV (docs/interfaces.md §1): `# key: value` lines, header, rows.
-
-    Density is written as `rho_kgm3`; the optional columns only when present.
-    """
-    columns = list(WRITTEN_COLUMNS)
-    data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
-    for name in WRITTEN_OPTIONAL_COLUMNS:
-        if getattr(flight, name) is not None:
-            columns.append(name)
-            data.append(getattr(flight, name))
+    """Write `flight` as a flight CSV (docs/interfaces.md §1): `# key: value` lines, header, rows;
+    the columns WRITTEN_COLUMNS, then those of WRITTEN_IF_PRESENT the flight has."""
+    optional = [name for name in WRITTEN_IF_PRESENT if getattr(flight, name) is not None]
+    columns = [*WRITTEN_COLUMNS, *optional]
+    data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3,
+            *(getattr(flight, name) for name in optional)]
     meta = {**flight.meta, **(comments or {})}
     header = "".join(f"# {key}: {value}\n" for key, value in meta.items()) + ",".join(columns)
     with atomic_open(path, "w") as fh:          # whole or not at all: never a spliced file
@@ -108,11 +103,9 @@ OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_ref_pa")
 STATIC_COLUMNS = ("ps_pa", "oat_k")
 # total air temperature and humidity, converted by core.moist_air
 TEMPERATURE_COLUMNS = ("tat_k", "rh_pct")
-# What `write_flight_csv` writes: these columns always, in this order, then those of the
-# optional ones (Flight fields of the same names) the flight has.
+# The columns `write_flight_csv` writes, in order (the optional ones: Flight fields it has)
 WRITTEN_COLUMNS = (*REQUIRED_COLUMNS, "rho_kgm3")
-WRITTEN_OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa",
-                            *TEMPERATURE_COLUMNS)
+WRITTEN_IF_PRESENT = ("gps_vd_mps", "alt_m", *STATIC_COLUMNS, "ps_ref_pa", *TEMPERATURE_COLUMNS)
 MIN_ROWS = 10
 
 
