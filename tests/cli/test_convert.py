@@ -47,22 +47,27 @@ def test_convert_window_and_warning_lines(tmp_path, flight, capsys):
     assert t[0] >= 20.0 and t[-1] <= 80.0 and t.size == pytest.approx(600, abs=2)
 
 
-def _errors(tmp, data):
-    trunc = tmp / "cut.bin"
-    trunc.write_bytes((data / "ardupilot" / "arduplane_no_airspeed.bin").read_bytes()[:4000])
+def _errors(tmp, shared_file):
+    """(path, message) of each unusable input, its shared log fetched only when used."""
+    def truncated():
+        trunc = tmp / "cut.bin"
+        trunc.write_bytes(shared_file("ardupilot/arduplane_no_airspeed.bin").read_bytes()[:4000])
+        return trunc
+
     return [
-        (data / "ardupilot" / "arduplane_no_airspeed.bin",
+        (lambda: shared_file("ardupilot/arduplane_no_airspeed.bin"),
          "arduplane_no_airspeed.bin: no airspeed data (ARSP) in the log; ARSPD_ENABLE=0"),
-        (data / "px4-ulog" / "sample_log_small.ulg",
+        (lambda: shared_file("px4-ulog/sample_log_small.ulg"),
          "sample_log_small.ulg: too little usable airborne data (on the ground throughout?)"),
-        (trunc, "cut.bin: no data messages in the log; truncated or corrupt file?"),
-        (tmp / "flight.xyz", "flight.xyz: unknown log extension '.xyz'"),
+        (truncated, "cut.bin: no data messages in the log; truncated or corrupt file?"),
+        (lambda: tmp / "flight.xyz", "flight.xyz: unknown log extension '.xyz'"),
     ]
 
 
 @pytest.mark.parametrize("case", range(4))
-def test_convert_errors_exit_2_with_one_line(case, tmp_path, shared_data, capsys):
-    path, message = _errors(tmp_path, shared_data)[case]
+def test_convert_errors_exit_2_with_one_line(case, tmp_path, shared_file, capsys):
+    get_path, message = _errors(tmp_path, shared_file)[case]
+    path = get_path()
     assert main(["convert", str(path), "-o", str(tmp_path / "out.csv")]) == 2
     err = [line for line in capsys.readouterr().err.splitlines()
            if not line.startswith("warning: ")]
@@ -76,10 +81,10 @@ def test_convert_refuses_to_overwrite_its_input(tmp_path, flight, capsys):
     assert "would overwrite the input log" in capsys.readouterr().err
 
 
-def test_identify_reads_the_sitl_log_directly(shared_data, tmp_path, capsys):
+def test_identify_reads_the_sitl_log_directly(shared_file, tmp_path, capsys):
     """INTERFACES §8 done-when: the SITL DataFlash log, calm air, calibrated end to end."""
     out = tmp_path / "r.json"
-    log = shared_data / "ardupilot" / "arduplane_sitl.log"
+    log = shared_file("ardupilot/arduplane_sitl.log")
     assert main(["identify", str(log), "--model", "constant", "--json", str(out)]) == 0
     result = json.loads(out.read_text())
     assert result["converged"] and result["parameters"]["wind_speed_mps"]["value"] < 1.0

@@ -90,10 +90,10 @@ def test_dataflash_end_to_end_mavproxy_file(flight, tmp_path, capsys):
     assert "current value 2;" in out.read_text()
 
 
-def test_arduplane_sitl_ratio_within_one_percent(shared_data, tmp_path):
+def test_arduplane_sitl_ratio_within_one_percent(shared_file, tmp_path):
     from pymavlink.mavparm import MAVParmDict
 
-    log = shared_data / "ardupilot" / "arduplane_sitl.log"
+    log = shared_file("ardupilot/arduplane_sitl.log")
     out = tmp_path / "sitl.param"
     assert main(["identify", str(log), "--oat-c", "15", "--params", str(out)]) == 0
     loaded = MAVParmDict()

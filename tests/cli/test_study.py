@@ -28,10 +28,10 @@ def test_lean_coverage_prints_its_result_and_repeats_a_run(tmp_path, capsys):
     assert row["seed"] == 3 and row["run_index"] == 1
 
 
-def test_real_alfa_from_any_folder_with_the_environment_variable(shared_data, tmp_path,
+def test_real_alfa_from_any_folder_with_the_environment_variable(shared_file, tmp_path,
                                                                  monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("PITOTCAL_ALFA_DATA", str(shared_data / "alfa-carbonz"))
+    monkeypatch.setenv("PITOTCAL_ALFA_DATA", str(shared_file("alfa-carbonz")))
     assert main(["study", "real-alfa", "--out", "out"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("study real-alfa: 1 run, 0 failed, ")

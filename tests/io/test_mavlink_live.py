@@ -83,7 +83,7 @@ def test_nothing_arrives():
     assert isinstance(buf, MavlinkFlightBuffer)
 
 
-def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
+def test_sitl_log_replayed_as_mavlink(shared_file, tmp_path, capsys):
     """The ArduPlane SITL DataFlash log, as pitotcal reads it, sent as SCALED_PRESSURE and
     GLOBAL_POSITION_INT: `identify --live` writes, the moment the stream stops, the
     identification of the same samples read from a file (a flight CSV of them)."""
@@ -93,7 +93,7 @@ def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
     from pitotcal.io import read_flight, write_flight_csv
 
     with pytest.warns(UserWarning):
-        log = read_flight(shared_data / "ardupilot" / "arduplane_sitl.log")
+        log = read_flight(shared_file("ardupilot/arduplane_sitl.log"))
     sent = as_sent(log)[0]
     csv = write_flight_csv(sent, tmp_path / "sitl.csv")
     assert main(["identify", str(csv), "--json", str(tmp_path / "file.json")]) == 0
