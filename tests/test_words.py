@@ -174,3 +174,19 @@ def test_the_command_line_shows_flags_for_the_named_arguments(argv, message, sho
     args = parser.parse_args(argv)
     assert flag_message(parser, args, PitotcalError(message)) == shown
     assert flag_message(parser, args, UserWarning(message)) == shown
+
+
+def test_gitignore_ignores_no_tracked_file():
+    """Every .gitignore line is for generated files: none matches a file the repository tracks
+    (docs, figures, examples)."""
+    import shutil
+    import subprocess
+
+    root = Path(__file__).resolve().parents[1]
+    if shutil.which("git") is None or not (root / ".git").exists():
+        pytest.skip(f"{root} is not a git checkout")
+    patterns = [line for line in (root / ".gitignore").read_text().splitlines()
+                if line and not line.startswith("#")]
+    run = subprocess.run(["git", "ls-files", "-ci", "--exclude-standard"], cwd=root,
+                         capture_output=True, text=True, check=True)
+    assert patterns and run.stdout == ""
