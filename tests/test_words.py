@@ -58,7 +58,9 @@ def _constants():
     from pitotcal.estimation.identification import budget
     from pitotcal.estimation.legs.flight import DETECT_DEFAULTS, POINT_TOL_KT
     from pitotcal.estimation.legs.global_fit import BAND_FT
+    from pitotcal.estimation.monitor.cusum import MonitorOptions
     from pitotcal.io.alfa import ALFA_DATA_ENV, ALFA_DIR_NAME
+    from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
     from pitotcal.maneuvers.fly.jsbsim_engine import DEFAULT_AIRCRAFT
     from pitotcal.maneuvers.fly.simulator import simulate
     from pitotcal.maneuvers.plan.design import STALL_DEFAULT_RATIO
@@ -66,7 +68,7 @@ def _constants():
     from pitotcal.maneuvers.plan.planner import MAX_ITER, plan_maneuver
     from pitotcal.studies.demo import DEMO_SIM
 
-    b, d = budget.BudgetInputs(), DesignOptions()
+    b, d, m = budget.BudgetInputs(), DesignOptions(), MonitorOptions()
     return [
         ("identify", f"else {budget.RH_U_UNKNOWN_PCT:.0f} (dry assumed"),
         ("identify", f"default {budget.RH_U_GIVEN_PCT:g} with a humidity"),
@@ -95,6 +97,11 @@ def _constants():
         ("simulate", f"(default {DEFAULT_AIRCRAFT})"),
         ("study", f"${ALFA_DATA_ENV}, else ./{ALFA_DIR_NAME}"),
         ("study", f"JSBSim's {DEFAULT_AIRCRAFT};"),
+        *[(command, f"without a message (default {IDLE_TIMEOUT_S:g})")
+          for command in ("identify", "monitor")],
+        ("monitor", f"per flight hour (default {m.false_alarms_per_hour:g})"),
+        ("monitor", f"without alarms (default {m.warmup_s:g})"),
+        ("monitor", f"kt/min (default {m.drift_kt_per_min:g})"),
     ]
 
 

@@ -41,6 +41,14 @@ def oat_k_from_c(oat_c):
     return oat_c + 273.15
 
 
+def idle_timeout_s(idle_s):
+    """--idle-s checked, or the stream reader's own idle timeout when not given."""
+    from pitotcal.core.checks import positive
+    from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
+
+    return IDLE_TIMEOUT_S if idle_s is None else positive("idle_s", idle_s)
+
+
 def announce_stream(command, connection, idle_s):
     """One stderr line as a live MAVLink stream starts: where it listens, how long it waits."""
     import sys

@@ -59,9 +59,9 @@ def add_parser(subparsers):
                       help="re-identify the growing maneuver every second from a MAVLink "
                            "stream (udp:127.0.0.1:14550), show dV and its 2-sigma, and write "
                            "the final result when the stream stops (or on Ctrl-C)")
-    live.add_argument("--idle-s", type=float, default=3.0, metavar="S",
+    live.add_argument("--idle-s", type=float, default=None, metavar="S",
                       help="live: the stream has ended after S seconds without a message "
-                           "(default %(default)g)")
+                           "(default {idle_s:g})")
     live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
@@ -118,18 +118,19 @@ _BUDGET_FLAGS = (
 
 
 def _help_constants():
-    """The library constants `identify --help` quotes (the budget re-solves each source at
-    +u and -u)."""
+    """The library constants `identify --help` quotes (the budget re-solves each source twice)."""
     import dataclasses
 
     from pitotcal.estimation.identification import budget
+    from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
     from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
     defaults = dataclasses.asdict(budget.BudgetInputs())
     return {**defaults, "u_qc_scale_percent": 100.0 * defaults["u_qc_scale"],
             "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
             "budget_solves": 2 * len(budget.SOURCES), "ardupilot_param": ARDUPILOT_RATIO,
-            "px4_params": " or ".join(PX4_SCALES), "px4_param": PX4_SCALES[0]}
+            "px4_params": " or ".join(PX4_SCALES), "px4_param": PX4_SCALES[0],
+            "idle_s": IDLE_TIMEOUT_S}
 
 
 def _budget_inputs(args):
@@ -346,7 +347,7 @@ def _run_live(args):
     """`--live CONNECTION`: estimation.live.identify_stream, its updates on stderr."""
     import sys
 
-    from .common import announce_stream, check_outputs, oat_k_from_c
+    from .common import announce_stream, check_outputs, idle_timeout_s, oat_k_from_c
     from pitotcal.core.checks import choice, positive
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -375,7 +376,7 @@ def _run_live(args):
               f"{fix.dv_kt:+6.2f} +/- {fix.dv_2sigma_kt:5.2f} kt (2 sigma)  "
               f"[{fix.update_s * 1000:4.0f} ms]{flag}", file=sys.stderr)
 
-    oat_k, idle_s = oat_k_from_c(args.oat_c), positive("idle_s", args.idle_s)
+    oat_k, idle_s = oat_k_from_c(args.oat_c), idle_timeout_s(args.idle_s)
     announce_stream("identify", args.live, idle_s)
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
