@@ -19,14 +19,14 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
-from pitotcal.io.mavlink_live import read_stream
+from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S, read_stream
 
 __all__ = ["LiveFix", "LiveIdentifier", "identify_stream", "monitor_stream"]
 
 _MIN_IDENTIFY_S = 20.0      # no identification is tried on less than this much record
 
 
-def monitor_stream(source, calibration, options=None, *, oat_k=None, idle_timeout_s=3.0,
+def monitor_stream(source, calibration, options=None, *, oat_k=None, idle_timeout_s=IDLE_TIMEOUT_S,
                    on_status=None, max_s=None):
     """Monitor a live stream; returns (MonitorResult, stream buffer).
 
@@ -126,7 +126,7 @@ class LiveIdentifier:
 
 
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
-                    idle_timeout_s=3.0, on_fix=None, max_s=None, air="compressible",
+                    idle_timeout_s=IDLE_TIMEOUT_S, on_fix=None, max_s=None, air="compressible",
                     gps_error=None):
     """Re-identify the growing maneuver every second (warm-started, `LiveIdentifier`); returns
     (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`

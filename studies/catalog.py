@@ -163,7 +163,7 @@ def _check_runs(runs):
     runs = integer("runs", runs, 1)
     if runs > MAX_RUNS:
         raise PitotcalError(f"runs {runs} is more than one study takes ({MAX_RUNS}, held in "
-                            "memory): run several studies with different --seed", param="runs")
+                            "memory): run several studies, each with its own `seed`", param="runs")
     return runs
 
 

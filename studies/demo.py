@@ -26,7 +26,7 @@ __all__ = ["DEMO_SIM", "DemoResult", "format_table", "run_demo"]
 
 log = logging.getLogger(__name__)
 
-# "Light turbulence, realistic sensors" (issue 4): the simulator's defaults, written out here
+# "Light turbulence, realistic sensors": the simulator's defaults, written out here
 # so the demo does not change silently when they do.
 # Compressible truth, so the flight carries the static port and OAT and the demo shows the
 # default calibration (the standard CAS law, ΔV = ΔV_pc).

@@ -57,6 +57,23 @@ def test_lazy_namespaces_list_and_load_their_names(package):
         module.nope  # noqa: B018
 
 
+def test_subpackages_load_on_first_use_and_import_pitotcal_stays_cheap(tmp_path):
+    """The README's `pitotcal.studies.run_study` and `pitotcal.maneuvers.check_autothrottle`
+    work after `import pitotcal` alone, which loads no casadi, matplotlib, scipy or control."""
+    code = ("import sys, pitotcal; "
+            "heavy = sorted(m for m in ('casadi', 'matplotlib', 'scipy', 'control', "
+            "'pitotcal.studies', 'pitotcal.maneuvers') if m in sys.modules); "
+            "print(heavy, callable(pitotcal.studies.run_study), "
+            "callable(pitotcal.maneuvers.check_autothrottle), "
+            "pitotcal.estimation.identify is pitotcal.identify, "
+            "{'studies', 'maneuvers', 'estimation', 'io', 'core'} <= set(dir(pitotcal)))")
+    run = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                         text=True, check=True)
+    assert run.stdout.strip() == "[] True True True True"
+    with pytest.raises(AttributeError, match="has no attribute 'nope'"):
+        pitotcal.nope  # noqa: B018
+
+
 def test_the_command_line_starts_without_the_heavy_libraries(tmp_path):
     """Building the parser loads no numpy, casadi, matplotlib, scipy or studies."""
     code = ("import sys; from pitotcal.cli import build_parser; build_parser(); "

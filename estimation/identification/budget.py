@@ -16,7 +16,7 @@ fit alike) it keeps the second-order part a central difference would cancel. The
 each term against re-solves at half the step and against the bias the simulator injects.
 The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a counts a/√3):
 
-- oat: static air temperature, u = 1 K (a calibrated OAT probe ±1 K; the issue's figure); the
+- oat: static air temperature, u = 1 K (a calibrated OAT probe ±1 K); the
   density ρ → ρ T/(T ± u) and the static temperature itself.
 - humidity: relative humidity, u = 5 %RH with a humidity channel or --rh-percent, else 58 %RH
   (= 100/√3: dry air assumed while the truth is anywhere in 0-100 %, so the error is one-sided

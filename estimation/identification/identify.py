@@ -1,4 +1,4 @@
-"""`identify`: the public entry point of the output-error calibration (issue 2, item 3)."""
+"""`identify`: the public entry point of the output-error calibration."""
 
 import dataclasses
 import functools
@@ -49,7 +49,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         How the impact pressure follows from the true airspeed (`estimation.identification.residual`):
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
         temperature `oat_k`, with all the pressure error in the static source (the default),
-        or the paper's eq. 2, q_c = ½ρV_t² ("incompressible", results as before issue 9). A
+        or the paper's eq. 2, q_c = ½ρV_t² ("incompressible", no static port needed). A
         flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
         an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
         it instead, and the static and total pressure errors are separated
@@ -266,7 +266,7 @@ def _air_data(flight, air):
     if air == "compressible" and (flight.ps_pa is None or flight.oat_k is None):
         return "incompressible", ((
             f"{flight.source}: no static pressure and temperature (ps_pa, oat_k): fitted with "
-            "the incompressible q_c = rho V_t^2 / 2 (as --air incompressible), so V_c and dV "
+            "the incompressible q_c = rho V_t^2 / 2 (`air` incompressible), so V_c and dV "
             "are sqrt(2 q / rho0), not the standard calibrated airspeed; give ps_pa and oat_k "
             "for the compressible calibration"),)
     return air, ()

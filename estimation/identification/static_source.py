@@ -1,4 +1,4 @@
-"""Static-source products of a compressible calibration (issue 9, item 3).
+"""Static-source products of a compressible calibration.
 
 The "all error in the static source" reduction of USAF TPS / NTPS practice: the pitot's total
 pressure is exact, so the fitted pressure error is the static-source error,

@@ -154,7 +154,7 @@ def to_dict(result):
         "timing_s": dict(result.timing_s),
         "air_data": result.air_data,
     }
-    if result.consistency:          # issue 15 item 2: docs/interfaces.md §20
+    if result.consistency:          # docs/interfaces.md §20
         out["consistency"] = dict(result.consistency)
     if _compressible(result):
         h_ic = pressure_altitude_ic_m(result)

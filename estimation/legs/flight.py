@@ -131,7 +131,7 @@ def _extend(i, ok, track, gs, ias, track_tol, gs_tol, ias_tol):
     return j
 
 
-def parse_windows(text, option="--windows"):
+def parse_windows(text, option="windows"):
     """'t0-t1,t2-t3,...' (seconds of the flight's time base) -> list of (t0, t1, None)."""
     out = []
     for part in str(text).split(","):

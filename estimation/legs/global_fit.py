@@ -220,7 +220,7 @@ def _check_counts(legs, nk, ng, wind, stated):
             f"or choose a model with fewer coefficients")
     if m < need:
         per = "per point" if wind == "per-point" else "per altitude band"
-        hint = "one wind per altitude band (--wind per-band), " if wind == "per-point" else ""
+        hint = "one wind per altitude band (`wind` per-band), " if wind == "per-point" else ""
         raise ObservabilityError(
             f"{legs.source}: {m} legs cannot determine {nk} model coefficients and {ng} "
             f"wind{'s' * (ng != 1)} ({per}): {need} legs needed"

@@ -1,18 +1,20 @@
 """What the airspeed monitor knows of a calibration: the model, the wind, the air data and the
-residual noise model, and the ONE prediction of q_ci from GPS velocity (paper section VI.B).
+statistics of its residuals, and the ONE prediction of q_ci from GPS velocity (paper section VI.B).
 
 The prediction inverts the calibration: V_t² from GPS and the wind (`core.measurement`), the
 true impact pressure from it — ½ρV_t² (`core.measurement`, incompressible) or isentropic from
 V_t², p_s and T_s (`core.airdata`, compressible) as the calibration's ``"air_data"`` says (absent:
 incompressible) — then what the pitot reads through the identified pressure error.
 
-The noise model (`noise_model`) describes the calibration's output residuals on the monitor's
-block grid (BLOCK_S): the relative residual e = (q_ci − predicted)/predicted of each block, and
-the same in airspeed, ΔV_i = e V_i/2 (the unit the monitor tests in: turbulence moves the
-airspeed by about the same m/s at every speed, so its fraction of q_ci changes along a speed
-sweep, and icing lowers V_i by kt/min), are autoregressive (turbulence is colored: correlation
-times of seconds), e_k = Σ φ_i e_{k−i} + w_k, and the log of the in-block (detrended) variance
-of the measured q_ci, the signal's high-frequency "liveness", is roughly normal. `pitotcal identify --json` writes it as ``"noise_model"``.
+The block residual statistics (`block_residual_stats`) describe the calibration's output
+residuals on the monitor's block grid (BLOCK_S): the relative residual
+e = (q_ci − predicted)/predicted of each block, and the same in airspeed, ΔV_i = e V_i/2 (the
+unit the monitor tests in: turbulence moves the airspeed by about the same m/s at every speed, so
+its fraction of q_ci changes along a speed sweep, and icing lowers V_i by kt/min), are
+autoregressive (turbulence is colored: correlation times of seconds), e_k = Σ φ_i e_{k−i} + w_k,
+and the log of the in-block (detrended) variance of the measured q_ci, the signal's
+high-frequency "liveness", is roughly normal.
+`pitotcal identify --json` writes them as ``"noise_model"``.
 """
 
 from dataclasses import dataclass
@@ -36,8 +38,8 @@ __all__ = [
     "Blocks",
     "Calibration",
     "airspeed_residual_mps",
+    "block_residual_stats",
     "block_stats",
-    "noise_model",
     "predict_qci_pa",
 ]
 
@@ -86,7 +88,7 @@ class Calibration:
         """From an `IdentificationResult` in memory (its noise model computed here)."""
         wn, we = result.internal_params[-2:]
         return cls(result.model, tuple(map(float, result.coefficients)), float(wn), float(we),
-                   air_data, noise_model(result))
+                   air_data, block_residual_stats(result))
 
 
 def _fallback_noise(d):
@@ -182,8 +184,9 @@ def block_stats(time_s, qci_pa, block_s=BLOCK_S, t0=None):
     return Blocks(starts, stops, t[stops - 1], means, band)
 
 
-def noise_model(result, block_s=BLOCK_S):
-    """The calibration's residual noise model on the monitor's block grid.
+def block_residual_stats(result, block_s=BLOCK_S):
+    """The statistics of the calibration's residuals on the monitor's block grid, from which the
+    monitor designs its thresholds (the JSON's ``"noise_model"``).
 
     Returns
     -------

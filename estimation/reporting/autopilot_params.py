@@ -1,4 +1,4 @@
-"""The airspeed parameter an autopilot should load, from a calibration flight (issue 10).
+"""The airspeed parameter an autopilot should load, from a calibration flight.
 
 Derivation. Both autopilots turn the sensor's differential pressure Δp (offset removed; the
 q_ci pitotcal reads from the log, ArduPilot ``ARSP.DiffPress``, PX4 ``differential_pressure``)
@@ -33,6 +33,7 @@ import numpy as np
 from pitotcal.core.errors import ObservabilityError, PitotcalError
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import RHO0_KGM3
+from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
 __all__ = ["MIN_TRACK_SPREAD_DEG", "TOLERANCE", "ParameterRecommendation", "recommend",
            "write_parameter_file"]
@@ -43,7 +44,8 @@ MIN_TRACK_SPREAD_DEG = 270.0
 # Relative 2σ of the airspeed the new parameter gives above which a flight that cannot tell
 # the new value from the current one is refused: 1 % of airspeed (2 % of ARSPD_RATIO).
 TOLERANCE = 0.01
-PARAMETER = {"ArduPilot": "ARSPD_RATIO", "PX4": "ASPD_SCALE_1"}
+# The parameter written when the log has none of its names (PX4: the current name first)
+PARAMETER = {"ArduPilot": ARDUPILOT_RATIO, "PX4": PX4_SCALES[0]}
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""The calibration report: one self-contained HTML file from a result JSON (issue 10).
+"""The calibration report: one self-contained HTML file from a result JSON.
 
 `build_report` gathers what the template shows (title block, test conditions, method, the
 correction tables, figures as base64 PNG, warnings, compliance, legs, provenance, signatures);
@@ -52,7 +52,7 @@ def read_aircraft(path):
         with open(path, "rb") as f:
             doc = tomllib.load(f)
     except tomllib.TOMLDecodeError as exc:
-        raise PitotcalError(f"--aircraft {path}: not valid TOML ({exc})") from None
+        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML ({exc})") from None
     rows, seen = [], set()
     for table, key, label in AIRCRAFT_FIELDS:
         value = doc.get(table, {}).get(key) if isinstance(doc.get(table), dict) else None
@@ -301,14 +301,14 @@ def write_pdf(html_path, pdf_path):
     browser = next((shutil.which(b) for b in ("chromium", "chromium-browser", "google-chrome")
                     if shutil.which(b)), None)
     if browser is None:
-        raise PitotcalError("--pdf needs Chromium on PATH (Debian: apt-get install chromium)")
+        raise PitotcalError("`pdf_path` needs Chromium on PATH (Debian: apt-get install chromium)")
     # printed to a temporary file beside it, renamed when whole (pitotcal.io.atomic)
     with atomic_path(pdf_path) as tmp:
         cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--no-pdf-header-footer",
                f"--print-to-pdf={Path(tmp).resolve()}", Path(html_path).resolve().as_uri()]
         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=120, check=False)
         if proc.returncode != 0 or not Path(tmp).stat().st_size:
-            raise PitotcalError(f"--pdf: Chromium failed ({proc.stderr.strip()[-200:]})")
+            raise PitotcalError(f"`pdf_path`: Chromium failed ({proc.stderr.strip()[-200:]})")
     return pdf_path
 
 

@@ -1,4 +1,4 @@
-"""Consistency of the calibration over the flight (issue 15, item 2): a step-change test.
+"""Consistency of the calibration over the flight: a step-change test.
 
 One calibration for the whole record is the model; a leak, an iced or blocked port or a
 drift that starts mid-flight breaks it while the global fit stays tight, because the
@@ -131,8 +131,8 @@ def hidden_warning(source, details):
             f"{hidden['dv_shift_kt']:.2f} kt at {hidden['vi_kt']:.0f} kt, "
             f"{hidden['dv_shift_kt'] / hidden['dv_2sigma_reported_kt']:.1f} times the 2-sigma "
             "band the result reports there; fly "
-            "the speeds twice (plan --return: up and back down the speed range) to tell the "
-            "two apart")
+            "the speeds twice (plan a return sweep: up and back down the speed range) to tell "
+            "the two apart")
 
 
 def _scan(jac, r, qci, first, threshold):

@@ -1,4 +1,4 @@
-"""Robust identification (issue 15): plausibility gates before the fit, trimming after it.
+"""Robust identification: plausibility gates before the fit, trimming after it.
 
 A single sample can decide an output-error fit: a q_ci glitch of 0.01 Pa has a leverage of
 1/q_ci on the inverse coefficient, a density of 1e6 multiplies its predicted q_c by a million.

@@ -1,4 +1,4 @@
-"""Abrupt level changes of q_ci (issue 15, item 2): a leak that opens at once.
+"""Abrupt level changes of q_ci: a leak that opens at once.
 
 A leak, a blocked port or a loose line that sets in at once moves q_ci by a few percent from
 one sample to the next and keeps it there. The fit bends its coefficients to the change of
@@ -91,7 +91,7 @@ def jump_test(flight):
             f"steps by {details['jump_pa']:+.1f} Pa at once (q_ci {100 * abs(step):.1f}% "
             f"{side}, z = {details['z']:+.1f}, beyond {threshold:.1f}): a leak, a blockage or "
             "a loose line? One calibration for the whole record does not hold; calibrate "
-            "before and after it apart (--start-s, --end-s)"), details
+            "before and after it apart (`start_s`, `end_s`)"), details
 
 
 def _standardized(d, ok):

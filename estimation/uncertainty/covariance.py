@@ -111,9 +111,9 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
     window : {"multiscale", "exponential", "bartlett", "parzen"}
         How R_vv is formed: "multiscale" (default) models it as white noise plus exponentials
         of several correlation times, in the pressure and in the velocity
-        (`estimation.uncertainty.residual_noise`); "exponential" as white noise plus one exponential decay
-        (the model before issue 11); "bartlett" and "parzen" taper the sample
-        autocovariance with that lag window.
+        (`estimation.uncertainty.residual_noise`); "exponential" as white noise plus one
+        exponential decay; "bartlett" and "parzen" taper the sample autocovariance with that
+        lag window.
     lag : int, optional
         Truncation lag of "bartlett"/"parzen", samples; Andrews' AR(1) plug-in when None.
     information : ndarray, shape (p, p), optional
@@ -172,7 +172,7 @@ def colored_covariance(jac, residuals, *, window="multiscale", lag=None, informa
         a_inv = np.linalg.inv(instruments.T @ jac if information is None else information)
         cov = a_inv @ (0.5 * (middle + middle.T)) @ a_inv.T
     # The noise model is fitted to one record: its long-run variance has few degrees of
-    # freedom (T / (4 tau) for one exponential, `noise_model.DOF_TAUS`): Student-t widening.
+    # freedom (T / (4 tau) for one exponential, `DOF_TAUS`): Student-t widening.
     cov = cov * student_t_widening(dof) ** 2
     return ColoredCovariance(cov, lag, window, a, _few_stretches(residuals), dof)
 
@@ -250,8 +250,8 @@ def _decay_from_increments(residuals, ke):
     s << tau (the white part cancels) and tau ~ s var / (gamma(2s) - gamma(s)). Every increment
     counts, so the decay is known to CV ~ sqrt(2 tau / T) (0.23 measured on the T-2 flight)
     where a fit to the autocovariance's shape leans on its noisy long lags (CV 0.8 measured,
-    the main cause of the k1/k2 bounds' run-to-run scatter and, with the gust bias, their 89%
-    coverage before).
+    the main cause of the k1/k2 bounds' run-to-run scatter and, with the gust bias, of their 89%
+    coverage when the decay comes from that fit).
     """
     n = residuals.size
     s = max(round(ke / 12), 2)

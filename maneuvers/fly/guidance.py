@@ -7,8 +7,8 @@ Two tracking controllers fly the plan (maneuvers.fly.simulator prepares their re
 - the PI auto-throttle of maneuvers.plan.autothrottle (`autothrottle_law`): thrust on the plan's
   airspeed schedule, through an engine lag, against quadratic drag;
 
-and a proportional altitude hold. `fly` integrates pitotcal.core.dynamics.rhs with Heun's
-method, the controls and the wind held over each step.
+and a proportional altitude hold. `integrate_closed_loop` integrates pitotcal.core.dynamics.rhs
+with Heun's method, the controls and the wind held over each step.
 
 The loop is scalar Python over plain floats (16,000 steps for 320 s at 50 Hz are cheaper so than
 numpy calls on length-1 arrays); the controller steps are closures over plain lists so that a
@@ -22,7 +22,7 @@ import numpy as np
 from pitotcal.core.dynamics import rhs
 from pitotcal.core.units import G0_MPS2
 
-__all__ = ["GUIDANCE_GAINS", "autothrottle_law", "fly", "guidance_law"]
+__all__ = ["GUIDANCE_GAINS", "autothrottle_law", "guidance_law", "integrate_closed_loop"]
 
 # Lateral guidance: desired ground track = the path's direction + K_pos * distance to the path
 # (1/s); heading loop K_psi (1/s). K_pos is slow (time constant 20 s) so turbulence does not make
@@ -119,7 +119,7 @@ def autothrottle_law(refs, loop, feedforward, thrust_max):
     return step
 
 
-def fly(refs, wind, loop, limits):
+def integrate_closed_loop(refs, wind, loop, limits):
     """Integrate the shared dynamics under the autopilot through the wind field.
 
     Parameters

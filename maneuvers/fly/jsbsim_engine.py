@@ -25,8 +25,8 @@ import numpy as np
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import FT_TO_M, wind_vector_mps
 
-__all__ = ["DEFAULT_AIRCRAFT", "GAINS", "JSBSIM_RATE_HZ", "aircraft_names", "fly",
-           "milspec_setting", "new_fdm", "set_turbulence", "start"]
+__all__ = ["DEFAULT_AIRCRAFT", "GAINS", "JSBSIM_RATE_HZ", "aircraft_names", "milspec_setting",
+           "new_fdm", "run_closed_loop", "set_turbulence", "start"]
 
 DEFAULT_AIRCRAFT = "c172x"
 # JSBSim's own default rate is 120 Hz; 150 Hz is three steps per 50 Hz control step.
@@ -234,7 +234,7 @@ RECORD = {
 }
 
 
-def fly(fdm, refs, limits, opts, trim, center_deg, steps_per_control):
+def run_closed_loop(fdm, refs, limits, opts, trim, center_deg, steps_per_control):
     """Fly the references with JSBSim; the records at the sample times and the path indices."""
     from pitotcal.core.geo import offset_m_from_latlon
 

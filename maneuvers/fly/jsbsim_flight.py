@@ -15,8 +15,8 @@ from .jsbsim_engine import (
     DEFAULT_CENTER_DEG,
     GAINS,
     JSBSIM_RATE_HZ,
-    fly,
     new_fdm,
+    run_closed_loop,
     set_turbulence,
     start,
 )
@@ -55,7 +55,7 @@ def fly_jsbsim(plan, opts, seed, refs, limits):
         fdm = new_fdm(aircraft, refs.dt_s / steps, scratch)
         trim = start(fdm, plan, refs, opts, center_deg, alt_agl_m)
         sigma = set_turbulence(fdm, opts, alt_agl_m, seed)
-        record, path_index = fly(fdm, refs, limits, opts, trim, center_deg, steps)
+        record, path_index = run_closed_loop(fdm, refs, limits, opts, trim, center_deg, steps)
         del fdm                             # closes its output file before the folder goes
     return _outputs(refs, opts, seed, record, path_index,
                     {"engine": "jsbsim", "aircraft": aircraft, "milspec_sigma_mps": sigma,
@@ -98,7 +98,7 @@ def _outputs(refs, opts, seed, record, path_index, engine):
                         {**opts.to_dict(), **engine, **realised})
 
 
-# The own simulator's state columns (maneuvers.fly.guidance.fly), from the record.
+# The own simulator's state columns (maneuvers.fly.guidance.integrate_closed_loop), from the record.
 _STATES = ("north_m", "east_m", "alt_m", "heading_rad", "tas_mps", "bank_rad", "wind_n_mps",
            "wind_e_mps")
 

@@ -24,7 +24,7 @@ from .flyable import MAX_SAMPLES, MIN_SAMPLES, check_plan, check_pressure_error,
 __all__ = ["ENGINES", "ENGINE_AIR_DATA", "MAX_SAMPLES", "MIN_SAMPLES", "SIM_LIMITS", "AirSensors",
            "SimOptions", "SimulationOptions", "air_sensors", "check_plan", "simulation_options"]
 
-# Issue 15: upper bounds of the options, with the reason given when one is refused (the
+# Upper bounds of the options, with the reason given when one is refused (the
 # simulator would run, overflow or fill memory beyond them; nothing real lies there).
 # rate_hz is bounded by MAX_SAMPLES over the plan, gps_latency_s by the plan's length.
 SIM_LIMITS = {
@@ -207,7 +207,7 @@ _RUN_FIELDS = ("engine", "aircraft", "center_deg", "limits", "speed_loop", "keep
 
 @dataclass(frozen=True)
 class AirSensors:
-    """Air-data sensors and effects of the issue 9 budget (maneuvers.fly.sensors.air_records).
+    """Air-data sensors and the effects the uncertainty budget counts (sensors.air_records).
 
     Attributes
     ----------

@@ -169,7 +169,7 @@ def static_port_pa(ps_pa, qc_pa, model="inverse", k=None):
 
 
 def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
-    """The air-data truth and records of `AirSensors` (issue 9): (q_c, logged ρ, columns).
+    """The air-data truth and records of `AirSensors`: (q_c, logged ρ, columns).
 
     Parameters
     ----------

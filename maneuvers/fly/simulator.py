@@ -9,7 +9,7 @@
 3. wind field: the mean wind, a slow linear drift and Dryden turbulence (maneuvers.turbulence)
    on the same grid (`WindField`, `wind_field`);
 4. flying: lateral guidance and the PI auto-throttle of maneuvers.plan.autothrottle step the aircraft
-   through pitotcal.core.dynamics with Heun's method (maneuvers.fly.guidance.fly);
+   through pitotcal.core.dynamics with Heun's method (maneuvers.fly.guidance.integrate_closed_loop);
 5. sensors: the records pass through the sensor models of maneuvers.fly.sensors, and the true
    values become a frozen `Truth` (maneuvers.fly.truth).
 
@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from .guidance import GUIDANCE_GAINS, fly
+from .guidance import GUIDANCE_GAINS, integrate_closed_loop
 from ..plan.autothrottle import tune_autothrottle
 from .sensors import (
     air_records,
@@ -216,7 +216,7 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
     else:
         qc = impact_pressure_pa(rho, v_air ** 2)
     air = {}
-    if opts.air_sensors is not None:      # issue 9 item 7: temperature, humidity, probe arm
+    if opts.air_sensors is not None:      # temperature, humidity, probe arm
         qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
                                    opts.k)
     climb = np.gradient(alt, dt) if n > 1 else np.zeros(n)
@@ -365,7 +365,7 @@ def simulate(plan, options=None, *, seed=0, **overrides):
     speed_loop = opts.speed_loop
     if speed_loop is None:
         speed_loop = tune_autothrottle(0.5 * float(plan.tas_mps.min() + plan.tas_mps.max()))
-    states, path_index = fly(refs, wind, speed_loop, limits)
+    states, path_index = integrate_closed_loop(refs, wind, speed_loop, limits)
     states, w_up = _plunge(refs, wind, states, opts)
     flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps, w_up)
     tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)

@@ -43,4 +43,8 @@ _EXPORTS = {
 __all__ = list(_EXPORTS) + ["__version__"]  # noqa: PLE0604
 
 
-__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+# The subpackages, loaded on first use like the names above: `pitotcal.studies.run_study`
+# works after `import pitotcal` alone.
+_SUBPACKAGES = ("core", "io", "maneuvers", "estimation", "studies", "cli")
+
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS, _SUBPACKAGES)

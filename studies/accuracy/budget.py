@@ -1,10 +1,10 @@
-"""`budget` (issue 9): each Type B term of the uncertainty budget next to the statistical 2σ.
+"""`budget`: each Type B term of the uncertainty budget next to the statistical 2σ.
 
 The T-2 maneuver (planner defaults: 70-100 KCAS, 244 m, 5 m/s wind) is flown with
 compressible truth (the static error in the logged ps_pa) in calm air, light and moderate
 turbulence; each flight is identified (the default compressible fit) and its uncertainty budget computed
 with the documented default inputs (estimation.identification.budget.BudgetInputs) and a wingtip probe 1 m
-out (`probe_arm_m` = 1, the issue's example; 0 for a probe on the centre line). The table has,
+out (`probe_arm_m` = 1; 0 for a probe on the centre line). The table has,
 per flight, the largest standard uncertainty of ΔV over the flown range for each source; the
 figure sets them beside each other per turbulence level. The calm-air statistical part is what
 a Monte Carlo of our own simulator shows; the Type B terms are what it cannot.
@@ -12,7 +12,7 @@ a Monte Carlo of our own simulator shows; the Type B terms are what it cannot.
 
 import numpy as np
 
-from ..engine.common import fly, group, identify_flight, score, truth_for
+from ..engine.common import get_flight, group, identify_flight, score, truth_for
 from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
 
@@ -28,7 +28,7 @@ def task(seed, turbulence_mps):
     """One flight: its score against truth, and the budget's terms (max over V_i), kt."""
     from pitotcal.estimation.identification.budget import BudgetInputs, uncertainty_budget
 
-    flight, truth = fly(None, {"turbulence_mps": turbulence_mps, "air_data": "compressible"},
+    flight, truth = get_flight(None, {"turbulence_mps": turbulence_mps, "air_data": "compressible"},
                         seed)
     result = identify_flight(flight)
     budget = uncertainty_budget(flight, result, BudgetInputs(probe_arm_m=PROBE_ARM_M))

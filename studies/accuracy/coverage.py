@@ -13,7 +13,7 @@ import dataclasses
 
 import numpy as np
 
-from ..engine.common import column, fly, ok_rows, percent, score, truth_for
+from ..engine.common import column, get_flight, ok_rows, percent, score, truth_for
 from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
 
@@ -35,7 +35,7 @@ def run_scored(seed, sim, model="inverse", **identify_options):
     with the z-scores against the wind flown through as ``P_z_flown``."""
     from pitotcal.estimation import identify
 
-    flight, truth = fly(None, sim, seed)
+    flight, truth = get_flight(None, sim, seed)
     result = identify(flight, model=model, **identify_options)
     mean = truth.wind_mean_process
     process = dataclasses.replace(truth, parameters={

@@ -1,4 +1,4 @@
-"""`leak`: is a leak from mid-flight flagged, and does a clean flight stay quiet? (issue 15, item 2)
+"""`leak`: is a leak from mid-flight flagged, and does a clean flight stay quiet?
 
 Every run flies a maneuver (the T-2 one-way speed sweep, or the same flown up and back down
 the speeds, `plan --return`) in calm air or in turbulence, with or without a leak in the total
@@ -11,7 +11,7 @@ range, and how often it does so with no warning from the checks (a tight wrong a
 
 import numpy as np
 
-from ..engine.common import column, fly, identify_flight, ok_rows, percent, score, truth_for
+from ..engine.common import column, get_flight, identify_flight, ok_rows, percent, score, truth_for
 from .coverage import wilson_interval
 from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
@@ -28,7 +28,7 @@ def task(seed, plan, turbulence_mps, leak):
     """Fly, spoil (a leak when `leak` > 0), identify, score; with the checks' verdicts."""
     from pitotcal.maneuvers.fly.faults import apply_fault, check_fault
 
-    flight, truth = fly(PLANS[plan], {"turbulence_mps": turbulence_mps}, seed)
+    flight, truth = get_flight(PLANS[plan], {"turbulence_mps": turbulence_mps}, seed)
     if leak > 0:
         flight = apply_fault(flight, truth, check_fault("leak", ONSET_S, leak, seed))
     result = identify_flight(flight)

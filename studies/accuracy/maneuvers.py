@@ -8,7 +8,7 @@ planned in that time is a row with the planner's message.
 
 import numpy as np
 
-from ..engine.common import accuracy_summary, group, run_fly_identify
+from ..engine.common import accuracy_summary, group, simulate_identify_score
 from ..engine.figures import new_figure, plain_log_ticks, save
 from ..engine.study import MonteCarloStudy
 
@@ -20,7 +20,7 @@ QUICK_DURATIONS_S = (240.0,)
 
 
 def task(seed, profile, duration_s):
-    return run_fly_identify(seed, plan={"profile": profile, "duration_s": duration_s})
+    return simulate_identify_score(seed, plan={"profile": profile, "duration_s": duration_s})
 
 
 def cases(runs, quick):

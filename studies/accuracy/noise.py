@@ -1,7 +1,7 @@
 """`noise`: do the 2σ bounds hold, and how wide are they, when the noise has several time scales?
 
-Every run flies the T-2 continuous maneuver (as `coverage`) under one of the noise cases of
-issue 11 and identifies the inverse model: GPS velocity noise 0.5 m/s in 0.5 m/s turbulence
+Every run flies the T-2 continuous maneuver (as `coverage`) under one of four noise cases and
+identifies the inverse model: GPS velocity noise 0.5 m/s in 0.5 m/s turbulence
 (two time scales), calm air with a Gauss-Markov GPS velocity error (σ 0.05 m/s, τ 30 s, on top
 of the default white 0.05 m/s) identified without and with that error stated
 (`identify(gps_error_sigma_mps=, gps_error_tau_s=)`), and the `coverage` study's 1 m/s

@@ -11,7 +11,7 @@ import numpy as np
 from ..engine.common import (
     accuracy_summary,
     column,
-    fly,
+    get_flight,
     group,
     identify_flight,
     ok_rows,
@@ -31,7 +31,7 @@ PARAMETERS = ("k1", "k2", "wind_speed_mps", "wind_from_deg")
 
 
 def task(seed, n_samples_used):
-    flight, truth = fly(S2_PLAN, {}, seed)
+    flight, truth = get_flight(S2_PLAN, {}, seed)
     n = min(int(n_samples_used), flight.n)
     start = max(0, (flight.n - n) // 2)
     mask = np.zeros(flight.n, dtype=bool)

@@ -12,7 +12,7 @@ factor's effect rather than sampling noise.
 
 import numpy as np
 
-from ..engine.common import accuracy_summary, group, run_fly_identify
+from ..engine.common import accuracy_summary, group, simulate_identify_score
 from ..engine.figures import new_figure, plain_log_ticks, save
 from ..engine.study import MonteCarloStudy
 
@@ -44,8 +44,8 @@ def task(seed, factor, level, background_turbulence_mps=0.5):
     value = (level, 0.0) if key == "wind_drift_mps2" else level
     sim = {"turbulence_mps": background_turbulence_mps}
     if where == "plan":
-        return run_fly_identify(seed, plan={key: value}, sim=sim)
-    return run_fly_identify(seed, sim={**sim, key: value})
+        return simulate_identify_score(seed, plan={key: value}, sim=sim)
+    return simulate_identify_score(seed, sim={**sim, key: value})
 
 
 def cases(runs, quick):

@@ -10,7 +10,7 @@ import numpy as np
 
 from pitotcal.core.units import mps_to_kt
 
-from ..engine.common import column, group, ok_rows, percent, run_fly_identify, stats
+from ..engine.common import column, group, ok_rows, percent, simulate_identify_score, stats
 from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
 
@@ -23,7 +23,7 @@ QUICK_WINDS = ((5.0, 270.0),)
 
 def task(seed, profile, wind_speed_mps, wind_from_deg):
     wind = {"wind_speed_mps": wind_speed_mps, "wind_from_deg": wind_from_deg}
-    return run_fly_identify(seed, plan={"profile": profile, **wind}, sim=wind)
+    return simulate_identify_score(seed, plan={"profile": profile, **wind}, sim=wind)
 
 
 def cases(runs, quick):

@@ -1,4 +1,4 @@
-"""`design` (issue 13): the information-optimal speed schedule against the best paper profile.
+"""`design`: the information-optimal speed schedule against the best paper profile.
 
 Two-speed (the best of the paper's profiles in the `maneuvers` study) is flown for 240 s; the
 optimal design (`plan --design optimal`, with its check level, and without it) at several
@@ -17,7 +17,15 @@ without ramps - what no schedule can beat.
 
 import numpy as np
 
-from ..engine.common import column, fly, group, identify_flight, ok_rows, score, truth_delta_v_kt
+from ..engine.common import (
+    column,
+    get_flight,
+    group,
+    identify_flight,
+    ok_rows,
+    score,
+    truth_delta_v_kt,
+)
 from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
 
@@ -55,7 +63,7 @@ def plan_kwargs(design, duration_s):
 def task(seed, design, duration_s):
     """Fly and identify one flight of the design; the common score plus the 72-98 KIAS ones."""
     kwargs = plan_kwargs(design, duration_s)
-    flight, truth = fly(kwargs, {"turbulence_mps": TURBULENCE_MPS}, seed)
+    flight, truth = get_flight(kwargs, {"turbulence_mps": TURBULENCE_MPS}, seed)
     result = identify_flight(flight)
     row = score(result, truth, flight)
     dv, two_sigma = result.delta_v_kt(_GRID)

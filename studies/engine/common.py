@@ -21,14 +21,14 @@ __all__ = [
     "accuracy_summary",
     "column",
     "first_seconds",
-    "fly",
+    "get_flight",
     "get_plan",
     "group",
     "identify_flight",
     "ok_rows",
     "percent",
-    "run_fly_identify",
     "score",
+    "simulate_identify_score",
     "stats",
     "truth_delta_v_kt",
     "truth_for",
@@ -54,13 +54,13 @@ def _plan_cached(key):
     return plan_maneuver(**json.loads(key))
 
 
-def fly(plan_kwargs=None, sim_kwargs=None, seed=0):
+def get_flight(plan_kwargs=None, sim_kwargs=None, seed=0):
     """(Flight, truth) of `maneuvers.simulate` on the (cached) plan; cached per process."""
-    return _fly_cached(_key({**T2_PLAN, **(plan_kwargs or {})}), _key(sim_kwargs), int(seed))
+    return _flight_cached(_key({**T2_PLAN, **(plan_kwargs or {})}), _key(sim_kwargs), int(seed))
 
 
 @functools.lru_cache(maxsize=4)
-def _fly_cached(plan_key, sim_key, seed):
+def _flight_cached(plan_key, sim_key, seed):
     from pitotcal.maneuvers import simulate
     sim = json.loads(sim_key)
     for name in ("k", "wind_drift_mps2"):      # JSON turned tuples into lists
@@ -169,9 +169,9 @@ def score(result, truth, flight=None):
     return row
 
 
-def run_fly_identify(seed, plan=None, sim=None, model="inverse", seconds=None):
+def simulate_identify_score(seed, plan=None, sim=None, model="inverse", seconds=None):
     """Plan, fly and identify one flight (optionally only its first `seconds`); the scored row."""
-    flight, truth = fly(plan, sim, seed)
+    flight, truth = get_flight(plan, sim, seed)
     used = first_seconds(flight, seconds)
     return score(identify_flight(used, model), truth_for(truth, used), used)
 

@@ -220,7 +220,7 @@ def _connect(Client, scheduler):
     else:
         text = (str(exc).splitlines() or [""])[0] or type(exc).__name__
     # a typo'd address is bad input: one line, exit 2 (not a distributed traceback)
-    raise PitotcalError(f"--scheduler {scheduler!r}: cannot connect to a Dask scheduler "
+    raise PitotcalError(f"`scheduler` {scheduler!r}: cannot connect to a Dask scheduler "
                         f"({text}); expected e.g. tcp://HOST:8786 with `dask scheduler` "
                         "running there")
 

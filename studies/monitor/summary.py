@@ -1,5 +1,5 @@
 """The `monitor` study's summary: false alarms per flight hour (designed, measured, 95 % upper
-bound) per condition, detection per fault, and the issue's targets, met or not."""
+bound) per condition, detection per fault, and the monitor's targets, met or not."""
 
 import numpy as np
 
@@ -61,7 +61,7 @@ def _detection(rows, gates):
 
 
 def _targets(fa, det, targets):
-    """The issue's targets: the number reached and whether it met the target."""
+    """The monitor's targets: the number reached and whether it met the target."""
     def delays(key):
         e = det.get("turb-0.5", {}).get(key)
         if e is None or e["detected"] != 1.0:

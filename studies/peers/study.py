@@ -2,8 +2,8 @@
 flight time.
 
 Each run flies one seeded simulated calibration flight (`maneuvers.plan_maneuver` +
-`maneuvers.simulate`, through `studies.engine.common.fly`), then for each flight time T uses only the
-first T seconds:
+`maneuvers.simulate`, through `studies.engine.common.get_flight`), then for each flight time T
+uses only the first T seconds:
 
 - pitotcal: `estimation.identify` on [0, T] (it refuses, with ObservabilityError, while the
   track has not turned enough: recorded as "no estimate", not as an error);
@@ -28,7 +28,7 @@ from pitotcal.core.errors import ObservabilityError, PitotcalError
 from pitotcal.core.scenario import TRUE_K
 
 from .baselines import delta_v_kt_from_k1
-from ..engine.common import fly, stats, truth_delta_v_kt, vi_grid_kt, window_wind
+from ..engine.common import get_flight, stats, truth_delta_v_kt, vi_grid_kt, window_wind
 from .ardupilot import ardupilot_autocal
 from .figure import plot_peers
 from .px4 import px4_wind_estimator
@@ -139,7 +139,7 @@ def _peer_row(track, t_s, scoring):
 def peer_task(seed, truth_model, fit_model, k, plan, sim, times_s, vi_ref_kt):
     """One run of the study (module level: it goes to Dask workers): fly one seeded flight of
     the truth case and score every method at every T; a list of rows."""
-    flight, truth = fly(plan, {**sim, "model": truth_model, "k": tuple(k)}, seed)
+    flight, truth = get_flight(plan, {**sim, "model": truth_model, "k": tuple(k)}, seed)
     return compare_one_flight(flight, truth, times_s=times_s, model=fit_model,
                               vi_ref_kt=vi_ref_kt)
 

@@ -42,27 +42,32 @@ def test_convert_window_and_warning_lines(tmp_path, flight, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["warning: f.ulg: no outside air temperature in the log: density uses "
                    "differential_pressure.temperature (airspeed sensor), a sensor temperature, "
-                   "not OAT (pass oat_k, or --oat-c)"]
+                   "not OAT (give the outside air temperature, --oat-c)"]
     t = read_flight_csv(out).time_s
     assert t[0] >= 20.0 and t[-1] <= 80.0 and t.size == pytest.approx(600, abs=2)
 
 
-def _errors(tmp, data):
-    trunc = tmp / "cut.bin"
-    trunc.write_bytes((data / "ardupilot" / "arduplane_no_airspeed.bin").read_bytes()[:4000])
+def _errors(tmp, shared_file):
+    """(path, message) of each unusable input, its shared log fetched only when used."""
+    def truncated():
+        trunc = tmp / "cut.bin"
+        trunc.write_bytes(shared_file("ardupilot/arduplane_no_airspeed.bin").read_bytes()[:4000])
+        return trunc
+
     return [
-        (data / "ardupilot" / "arduplane_no_airspeed.bin",
+        (lambda: shared_file("ardupilot/arduplane_no_airspeed.bin"),
          "arduplane_no_airspeed.bin: no airspeed data (ARSP) in the log; ARSPD_ENABLE=0"),
-        (data / "px4-ulog" / "sample_log_small.ulg",
+        (lambda: shared_file("px4-ulog/sample_log_small.ulg"),
          "sample_log_small.ulg: too little usable airborne data (on the ground throughout?)"),
-        (trunc, "cut.bin: no data messages in the log; truncated or corrupt file?"),
-        (tmp / "flight.xyz", "flight.xyz: unknown log extension '.xyz'"),
+        (truncated, "cut.bin: no data messages in the log; truncated or corrupt file?"),
+        (lambda: tmp / "flight.xyz", "flight.xyz: unknown log extension '.xyz'"),
     ]
 
 
 @pytest.mark.parametrize("case", range(4))
-def test_convert_errors_exit_2_with_one_line(case, tmp_path, shared_data, capsys):
-    path, message = _errors(tmp_path, shared_data)[case]
+def test_convert_errors_exit_2_with_one_line(case, tmp_path, shared_file, capsys):
+    get_path, message = _errors(tmp_path, shared_file)[case]
+    path = get_path()
     assert main(["convert", str(path), "-o", str(tmp_path / "out.csv")]) == 2
     err = [line for line in capsys.readouterr().err.splitlines()
            if not line.startswith("warning: ")]
@@ -76,17 +81,20 @@ def test_convert_refuses_to_overwrite_its_input(tmp_path, flight, capsys):
     assert "would overwrite the input log" in capsys.readouterr().err
 
 
-def test_identify_reads_the_sitl_log_directly(shared_data, tmp_path, capsys):
+def test_identify_reads_the_sitl_log_directly(shared_file, tmp_path, capsys):
     """INTERFACES §8 done-when: the SITL DataFlash log, calm air, calibrated end to end."""
     out = tmp_path / "r.json"
-    log = shared_data / "ardupilot" / "arduplane_sitl.log"
+    log = shared_file("ardupilot/arduplane_sitl.log")
     assert main(["identify", str(log), "--model", "constant", "--json", str(out)]) == 0
     result = json.loads(out.read_text())
     assert result["converged"] and result["parameters"]["wind_speed_mps"]["value"] < 1.0
     warning = ("arduplane_sitl.log: no outside air temperature in the log: density uses "
-               "BARO.Temp (baro sensor), a sensor temperature, not OAT (pass oat_k, or --oat-c)")
+               "BARO.Temp (baro sensor), a sensor temperature, not OAT (give the outside air "
+               "temperature, `oat_k`)")
     cap = capsys.readouterr()
-    assert cap.err == f"warning: {warning}\n" and result["warnings"].count(warning) == 1
+    # the record names the Python argument, the command line its flag
+    assert cap.err == f"warning: {warning.replace('`oat_k`', '--oat-c')}\n"
+    assert result["warnings"].count(warning) == 1
     # the take-off and landing rolls are cut: the table starts at the slowest flight (19 kt,
     # ARSPD_FBW_MIN = 10 m/s), not at the 11 kt of the ground roll
     assert 19.0 < result["airspeed_correction"][0]["vi_kt"] < 19.5
@@ -178,3 +186,19 @@ def test_convert_window_errors_name_the_flags(tmp_path, flight, capsys, args, ma
                  *args]) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and re.search(match, err[0]), err
+
+
+@pytest.mark.parametrize("writer", [write_dataflash_bin, write_ulog])
+def test_convert_help_lists_the_columns_it_writes(tmp_path, flight, capsys, writer):
+    """`convert --help` lists the writer's columns of a log's flight: the 9 it writes."""
+    log = writer(tmp_path / ("f.bin" if writer is write_dataflash_bin else "f.ulg"), flight)
+    out = tmp_path / "f.csv"
+    assert main(["convert", str(log), "-o", str(out), "--oat-c", "15"]) == 0
+    header = next(line for line in out.read_text().splitlines() if not line.startswith("#"))
+    written = header.split(",")
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        main(["convert", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert len(written) == 9
+    assert f"flight CSV ({', '.join(written)};" in text

@@ -90,10 +90,10 @@ def test_dataflash_end_to_end_mavproxy_file(flight, tmp_path, capsys):
     assert "current value 2;" in out.read_text()
 
 
-def test_arduplane_sitl_ratio_within_one_percent(shared_data, tmp_path):
+def test_arduplane_sitl_ratio_within_one_percent(shared_file, tmp_path):
     from pymavlink.mavparm import MAVParmDict
 
-    log = shared_data / "ardupilot" / "arduplane_sitl.log"
+    log = shared_file("ardupilot/arduplane_sitl.log")
     out = tmp_path / "sitl.param"
     assert main(["identify", str(log), "--oat-c", "15", "--params", str(out)]) == 0
     loaded = MAVParmDict()
@@ -102,3 +102,16 @@ def test_arduplane_sitl_ratio_within_one_percent(shared_data, tmp_path):
     # measured: 1.99095 +/- 0.0087, -0.13 % from the simulator's 1.9936
     assert abs(ratio / 1.9936 - 1.0) < 0.01
     assert "current value 1.9936" in out.read_text()
+
+
+def test_params_help_says_the_px4_file_uses_the_logs_parameter_name(capsys):
+    """The QGC file carries the scale parameter the log has (ASPD_SCALE above), and the help
+    says so instead of promising ASPD_SCALE_1."""
+    from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
+
+    with pytest.raises(SystemExit):
+        main(["identify", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert (f"parameter file with {ARDUPILOT_RATIO}, for a PX4 log a QGroundControl parameter "
+            f"file with the scale parameter the log has ({' or '.join(PX4_SCALES)}; "
+            f"{PX4_SCALES[0]} when it has neither)") in text

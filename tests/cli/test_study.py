@@ -28,10 +28,10 @@ def test_lean_coverage_prints_its_result_and_repeats_a_run(tmp_path, capsys):
     assert row["seed"] == 3 and row["run_index"] == 1
 
 
-def test_real_alfa_from_any_folder_with_the_environment_variable(shared_data, tmp_path,
+def test_real_alfa_from_any_folder_with_the_environment_variable(shared_file, tmp_path,
                                                                  monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setenv("PITOTCAL_ALFA_DATA", str(shared_data / "alfa-carbonz"))
+    monkeypatch.setenv("PITOTCAL_ALFA_DATA", str(shared_file("alfa-carbonz")))
     assert main(["study", "real-alfa", "--out", "out"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("study real-alfa: 1 run, 0 failed, ")
@@ -112,4 +112,4 @@ def test_runs_above_the_cap_are_refused_with_the_cap(capsys):
     assert main(["study", "coverage", "--runs", "100000000"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == ("pitotcal study: --runs 100000000 is more than one study takes (100000, "
-                   "held in memory): run several studies with different --seed")
+                   "held in memory): run several studies, each with its own --seed")

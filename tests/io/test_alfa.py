@@ -8,8 +8,8 @@ from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.io.alfa import ALFA_DATA_ENV, find_alfa_data, read_alfa_csv, read_alfa_flight
 
 
-def test_reader_builds_powered_segment(shared_data):
-    f = read_alfa_flight(shared_data / "alfa-carbonz")
+def test_reader_builds_powered_segment(shared_file):
+    f = read_alfa_flight(shared_file("alfa-carbonz"))
     t_fail = float(f.meta["failure_time_s"])
     assert t_fail == pytest.approx(116.25, abs=0.1)
     assert f.time_s[-1] < t_fail
@@ -21,8 +21,8 @@ def test_reader_builds_powered_segment(shared_data):
     assert f.gps_vd_mps is not None
 
 
-def test_reader_density_choices(shared_data):
-    d = shared_data / "alfa-carbonz"
+def test_reader_density_choices(shared_file):
+    d = shared_file("alfa-carbonz")
     isa = read_alfa_flight(d, oat="isa")
     hot = read_alfa_flight(d, oat=310.0)
     assert np.median(isa.rho_kgm3) > np.median(hot.rho_kgm3)
@@ -33,9 +33,9 @@ def test_reader_density_choices(shared_data):
     ({"oat": 25.0}, "oat must be a temperature in K"),
     ({"margin_s": -1}, "margin_s must be >= 0"),
 ])
-def test_reader_errors(shared_data, kwargs, match):
+def test_reader_errors(shared_file, kwargs, match):
     with pytest.raises(PitotcalError, match=match):
-        read_alfa_flight(shared_data / "alfa-carbonz", **kwargs)
+        read_alfa_flight(shared_file("alfa-carbonz"), **kwargs)
 
 
 def test_reader_missing_dir(tmp_path):

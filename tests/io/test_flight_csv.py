@@ -286,9 +286,9 @@ def test_missing_file_is_an_oserror(tmp_path):
 
 
 @pytest.mark.filterwarnings("ignore::UserWarning")
-def test_logs_dispatch_to_estimation_logs(shared_data):
+def test_logs_dispatch_to_estimation_logs(shared_file):
     logs = pytest.importorskip("pitotcal.io.logs")
-    path = shared_data / "px4-ulog" / "sample_log_small.ulg"
+    path = shared_file("px4-ulog/sample_log_small.ulg")
     try:
         read_flight(path)
     except FlightDataError as exc:     # 6.5 s on the ground: a clear refusal is right too

@@ -1,5 +1,6 @@
 """Log readers (estimation.logs, .ulog, .dataflash): logs written here with known content, the
-shared real/SITL logs (skipped when ../shared/data is absent), and every error case."""
+shared real/SITL logs (skipped, naming PITOTCAL_SHARED_DATA and the file, when absent), and
+every error case."""
 
 import logging
 import shutil
@@ -265,11 +266,11 @@ def test_argument_errors(kwargs, match, tmp_path):
 
 # --- the shared logs ----------------------------------------------------------------------
 
-def test_sitl_dataflash_calibrates_end_to_end(shared_data):
+def test_sitl_dataflash_calibrates_end_to_end(shared_file):
     """ArduPlane SITL, calm air, ARSPD_RATIO 1.9936: wind < 1 m/s; with the simulator's air
     temperature (ISA, 15 degC at its field) the constant model gives back the ratio through
     0.5 rho0 ratio = 1/(1 - k1)."""
-    path = shared_data / "ardupilot" / "arduplane_sitl.log"
+    path = shared_file("ardupilot/arduplane_sitl.log")
     flog = load_log(path, oat_k=288.15)
     assert flog.autopilot.startswith("ArduPlane V4.1.0dev")
     assert flog.airspeed_scale["ARSPD_RATIO"] == pytest.approx(1.9936)
@@ -298,10 +299,10 @@ def test_sitl_dataflash_calibrates_end_to_end(shared_data):
     ("px4-ulog/sample_log_small.ulg",
      r"sample_log_small\.ulg: too little usable airborne data \(on the ground throughout\?\)"),
 ])
-def test_shared_logs_that_cannot_calibrate(relpath, match, shared_data):
+def test_shared_logs_that_cannot_calibrate(relpath, match, shared_file):
     with pytest.raises(FlightDataError, match=match):
         with pytest.warns(UserWarning) if relpath.endswith(".ulg") else _nothing():
-            read_log(shared_data / relpath)
+            read_log(shared_file(relpath))
 
 
 @pytest.mark.parametrize("relpath,n_bytes,match", [
@@ -309,8 +310,8 @@ def test_shared_logs_that_cannot_calibrate(relpath, match, shared_data):
     ("ardupilot/arduplane_no_airspeed.bin", 4000, r"no data messages in the log"),
     ("px4-ulog/sample_log_small.ulg", 5000, r"no logged data after the ULog header"),
 ])
-def test_truncated_copies_of_shared_logs(relpath, n_bytes, match, shared_data, tmp_path):
-    src = shared_data / relpath
+def test_truncated_copies_of_shared_logs(relpath, n_bytes, match, shared_file, tmp_path):
+    src = shared_file(relpath)
     copy = tmp_path / src.name
     shutil.copyfile(src, copy)
     with open(copy, "r+b") as f:
@@ -319,8 +320,8 @@ def test_truncated_copies_of_shared_logs(relpath, n_bytes, match, shared_data, t
         read_log(copy)
 
 
-def test_ulog_reader_on_real_px4_log(shared_data):
+def test_ulog_reader_on_real_px4_log(shared_file):
     """The real PX4 v1.11 log: slow differential_pressure falls back on the airspeed topic."""
     with pytest.warns(UserWarning, match="differential_pressure is logged at only 1.0 Hz"):
         with pytest.raises(FlightDataError):
-            read_log(shared_data / "px4-ulog" / "sample_log_small.ulg")
+            read_log(shared_file("px4-ulog/sample_log_small.ulg"))

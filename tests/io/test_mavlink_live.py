@@ -14,7 +14,7 @@ from pitotcal.maneuvers.fly.faults import Fault, apply_fault
 from plans import circle_plan
 
 from pitotcal.core.errors import FlightDataError
-from pitotcal.io.mavlink_live import MavlinkFlightBuffer, read_stream
+from pitotcal.io.mavlink_live import FIRST_MESSAGE_TIMEOUT_S, MavlinkFlightBuffer, read_stream
 
 pytest.importorskip("pymavlink")
 
@@ -83,7 +83,7 @@ def test_nothing_arrives():
     assert isinstance(buf, MavlinkFlightBuffer)
 
 
-def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
+def test_sitl_log_replayed_as_mavlink(shared_file, tmp_path, capsys):
     """The ArduPlane SITL DataFlash log, as pitotcal reads it, sent as SCALED_PRESSURE and
     GLOBAL_POSITION_INT: `identify --live` writes, the moment the stream stops, the
     identification of the same samples read from a file (a flight CSV of them)."""
@@ -93,7 +93,7 @@ def test_sitl_log_replayed_as_mavlink(shared_data, tmp_path, capsys):
     from pitotcal.io import read_flight, write_flight_csv
 
     with pytest.warns(UserWarning):
-        log = read_flight(shared_data / "ardupilot" / "arduplane_sitl.log")
+        log = read_flight(shared_file("ardupilot/arduplane_sitl.log"))
     sent = as_sent(log)[0]
     csv = write_flight_csv(sent, tmp_path / "sitl.csv")
     assert main(["identify", str(csv), "--json", str(tmp_path / "file.json")]) == 0
@@ -149,3 +149,22 @@ def test_monitor_cli_on_a_stream(flights, tmp_path, capsys):
     assert code == 1 and len(alarms) == 1 and alarms[0]["kind"] == "step"
     assert alarms[0]["start_s"] == monitor(flight, cal).alarms[0]["start_s"]
     assert "samples  q_ci" in err          # the live status line
+    # the first line says where it listens, at once (not after the first message's wait)
+    assert err.splitlines()[0] == (
+        f"pitotcal monitor: listening on udpin:127.0.0.1:{port} for MAVLink (up to "
+        f"{FIRST_MESSAGE_TIMEOUT_S:g} s for the first message, then ends after 1 s without "
+        "one, or on Ctrl-C)")
+
+
+def test_identify_live_says_where_it_listens_first(flights, tmp_path, capsys):
+    from pitotcal.cli import main
+
+    _, flight = flights
+    port = free_udp_port()
+    send_flight(flight.window(None, 60.0), port)
+    assert main(["identify", "--live", f"udp:127.0.0.1:{port}", "--idle-s", "1",
+                 "--air", "incompressible"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith(f"pitotcal identify: listening on udp:127.0.0.1:{port} for "
+                             f"MAVLink (up to {FIRST_MESSAGE_TIMEOUT_S:g} s")
+    assert any("dV at" in line for line in err[1:])

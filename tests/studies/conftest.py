@@ -6,6 +6,6 @@ def fresh_cache():
     """Empty the per-process plan/flight caches of the studies around a test."""
     from pitotcal.studies.engine import common
 
-    common._fly_cached.cache_clear()
+    common._flight_cached.cache_clear()
     yield
-    common._fly_cached.cache_clear()
+    common._flight_cached.cache_clear()

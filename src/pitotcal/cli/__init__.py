@@ -38,6 +38,27 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(2, f"{self.prog}: {message} (see {self.prog} --help)\n")
 
+    def help_from(self, constants):
+        """Fill the ``{name}`` fields of this parser's help texts from `constants()`, a
+        function returning {name: value}, when the help is shown: the texts quote the library's
+        own constants, and only ``--help`` imports the (numpy-heavy) modules holding them."""
+        self._help_constants = constants
+
+    def format_help(self):
+        constants = getattr(self, "_help_constants", None)
+        if constants is not None:
+            values = constants()
+            for action in self._actions:
+                if action.help and action.help is not argparse.SUPPRESS:
+                    action.help = action.help.format_map(values)
+            for group in self._action_groups:
+                if group.description:
+                    group.description = group.description.format_map(values)
+            if self.description:
+                self.description = self.description.format_map(values)
+            self._help_constants = None
+        return super().format_help()
+
 
 def build_parser():
     parser = _Parser(
@@ -59,15 +80,22 @@ def build_parser():
 # The readers' window parameters, shown as the flags where a message names them with a value
 # or a rule ("start_s=10", "start_s 5 must be ..."), never inside a file name.
 _WINDOW = re.compile(r"(?<![\w/.\\-])(start_s|end_s)(?:(=)|(?= (?:[-+]?[\d.]|must\b|is\b)))")
-# Library parameters whose flag has another name or unit (oat_k is also a flight-CSV column,
-# so it is replaced only when the error is about it).
-_FLAG_DEST = {"oat_k": "oat_c", "gps_noise_std_mps": "gps_noise_mps"}
+# Library parameters whose flag has another name (or unit: oat_k is also a flight-CSV column,
+# so it is replaced only when the error is about it, or named in backquotes).
+_FLAG_DEST = {"oat_k": "oat_c", "gps_noise_std_mps": "gps_noise_mps", "aircraft_path": "aircraft",
+              "pdf_path": "pdf"}
+
+
+# A library message (error or warning) names a Python argument in backquotes (`oat_k`): the
+# command line shows the command's flag for it (--oat-c), the Python user reads the argument.
+_ARGUMENT = re.compile(r"`([a-z][a-z0-9_]*)`")
 
 
 def flag_message(parser, args, exc):
-    """The error's message as the command's user knows it: the library parameters it names
-    (`exc.param`, `exc.mentions`, e.g. ``cas_min_kt``) and the window parameters shown as flags
-    (``--cas-min-kt``, ``start_s=10`` as ``--start-s 10``)."""
+    """The error's (or warning's) message as the command's user knows it: the library
+    parameters it names (`exc.param`, `exc.mentions`, e.g. ``cas_min_kt``, or any in
+    backquotes, ```oat_k```) and the window parameters shown as flags (``--cas-min-kt``,
+    ``--oat-c``, ``start_s=10`` as ``--start-s 10``)."""
     message = str(exc)
     command = parser._subparsers._group_actions[0].choices[args.command]
     flags = {a.dest: max(a.option_strings, key=len) for a in command._actions if a.option_strings}
@@ -78,11 +106,15 @@ def flag_message(parser, args, exc):
         flag = flags.get(_FLAG_DEST.get(name, name))
         if flag:            # the parameter as a word of its own, not part of a file name
             message = re.sub(rf"(?<![\w/.\\-]){re.escape(name)}(?![\w/.\\-])", flag, message)
-    return message
+    return _ARGUMENT.sub(lambda m: flags.get(_FLAG_DEST.get(m[1], m[1]), m[0]), message)
 
 
-def _one_line_warning(message, category, filename, lineno, file=None, line=None):
-    print(f"warning: {message}", file=file or sys.stderr)
+def _warning_printer(parser, args):
+    """`warnings.showwarning` of the command line: one ``warning:`` line, with its flags."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        print(f"warning: {flag_message(parser, args, message)}", file=file or sys.stderr)
+
+    return show
 
 
 def main(argv=None):
@@ -90,7 +122,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(message)s")
-    warnings.showwarning = _one_line_warning
+    warnings.showwarning = _warning_printer(parser, args)
     from pitotcal.core.errors import PitotcalError
 
     try:

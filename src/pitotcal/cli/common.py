@@ -41,6 +41,26 @@ def oat_k_from_c(oat_c):
     return oat_c + 273.15
 
 
+def idle_timeout_s(idle_s):
+    """--idle-s checked, or the stream reader's own idle timeout when not given."""
+    from pitotcal.core.checks import positive
+    from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
+
+    return IDLE_TIMEOUT_S if idle_s is None else positive("idle_s", idle_s)
+
+
+def announce_stream(command, connection, idle_s):
+    """One stderr line as a live MAVLink stream starts: where it listens, how long it waits."""
+    import sys
+
+    from pitotcal.io.mavlink_live import FIRST_MESSAGE_TIMEOUT_S, LISTENING_PREFIXES
+
+    how = "listening on" if str(connection).startswith(LISTENING_PREFIXES) else "connecting to"
+    print(f"pitotcal {command}: {how} {connection} for MAVLink (up to "
+          f"{FIRST_MESSAGE_TIMEOUT_S:g} s for the first message, then ends after {idle_s:g} s "
+          "without one, or on Ctrl-C)", file=sys.stderr, flush=True)
+
+
 def check_outputs(outputs, inputs=(), *, figures=()):
     """Refuse, before any work, an output a command must not or could not write: THE check of
     every command's output paths.

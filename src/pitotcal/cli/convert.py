@@ -13,7 +13,7 @@ def add_parser(subparsers):
                     "put GPS velocity, static pressure and temperature on the airspeed sensor's "
                     "time base, cut the GPS-invalid parts and what the autopilot did not fly "
                     "(its landed/armed state, take-off and landing rolls), and write the flight "
-                    "CSV (time_s, qc_pa, gps_vn_mps, gps_ve_mps, rho_kgm3, gps_vd_mps, alt_m). "
+                    "CSV ({columns}; gps_vd_mps and alt_m when the log has them). "
                     "Comment lines name the source, the firmware, every conversion and cut, and "
                     "the autopilot's own wind and airspeed ratio/scale.")
     p.add_argument("log", metavar="LOG", help="log file: .ulg, .bin or .log")
@@ -23,7 +23,17 @@ def add_parser(subparsers):
     p.add_argument("--gps-resample", choices=("linear", "hold"), default="linear",
                    help="GPS onto the pressure times: interpolate between fixes, or hold the "
                         "last fix (default: %(default)s)")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
+
+
+def _help_constants():
+    """The columns `convert --help` lists: those the flight CSV writer writes of a log's flight."""
+    from pitotcal.io.flight_csv import WRITTEN_COLUMNS, WRITTEN_IF_PRESENT
+    from pitotcal.io.logs import LOG_COLUMNS
+
+    columns = [*WRITTEN_COLUMNS, *(c for c in WRITTEN_IF_PRESENT if c in LOG_COLUMNS)]
+    return {"columns": ", ".join(columns)}
 
 
 def run(args):

@@ -19,13 +19,21 @@ def add_parser(subparsers):
                     "calibration and the wind, print the calibration table next to the truth, and "
                     "write the calibration report (report.html).")
     p.add_argument("--out", dest="out_dir", default="pitotcal-demo", metavar="DIR",
-                   help="folder for plan, flight, result and figures (default: ./pitotcal-demo)")
-    p.add_argument("--seed", type=int, default=0, help="simulator seed (default 0)")
+                   help="folder for plan, flight, result and figures (default: ./%(default)s)")
+    p.add_argument("--seed", type=int, default=0, help="simulator seed (default %(default)s)")
     p.add_argument("--duration-s", type=float, default=T2_PLAN["duration_s"],
                    help="maneuver length, s (default %(default)g; shorter only for quick checks)")
     p.add_argument("--rate-hz", type=float, default=None,
-                   help="data rate, Hz (default: the demo's 50)")
+                   help="data rate, Hz (default: the demo's {rate_hz:g})")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
+
+
+def _help_constants():
+    """The demo's simulation settings, which `demo --help` quotes."""
+    from pitotcal.studies.demo import DEMO_SIM
+
+    return dict(DEMO_SIM)
 
 
 def run(args):

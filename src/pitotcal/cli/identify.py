@@ -28,14 +28,14 @@ def add_parser(subparsers):
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
-    # --- air data (issue 9) ---
+    # --- air data ---
     p.add_argument("--air", default="compressible", metavar="MODE",
                    help="how impact pressure follows from true airspeed: compressible "
                         "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
                         "all pressure error taken in the static source, or separated with "
                         "a ps_ref_pa reference column; V_i, V_c standard CAS) or "
                         "incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
-                        "paper's eq. 2 and the results before issue 9); a flight without "
+                        "paper's eq. 2; needs no static port); a flight without "
                         "ps_pa/oat_k is fitted incompressible with a warning; default "
                         "%(default)s")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")
@@ -45,26 +45,28 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
-    # issue 10: the airspeed parameter an autopilot loads (logic in estimation/autopilot.py)
+    # the airspeed parameter an autopilot loads (estimation.reporting.autopilot_params)
     g = p.add_argument_group("autopilot parameters")
     g.add_argument("--params", metavar="OUT", default=None,
                    help="write the recommended airspeed parameter: for an ArduPilot log a "
-                        "Mission Planner / MAVProxy parameter file with ARSPD_RATIO, for a PX4 "
-                        "log a QGroundControl parameter file with ASPD_SCALE_1 (the current "
-                        "value and the 2-sigma as comments); exit 2 with the reason when the "
+                        "Mission Planner / MAVProxy parameter file with {ardupilot_param}, for a "
+                        "PX4 log a QGroundControl parameter file with the scale parameter the log "
+                        "has ({px4_params}; {px4_param} when it has neither); the current "
+                        "value and the 2-sigma as comments; exit 2 with the reason when the "
                         "flight cannot support one")
     live = p.add_argument_group("live (a MAVLink stream instead of FLIGHT)")
     live.add_argument("--live", metavar="CONNECTION", default=None,
                       help="re-identify the growing maneuver every second from a MAVLink "
                            "stream (udp:127.0.0.1:14550), show dV and its 2-sigma, and write "
                            "the final result when the stream stops (or on Ctrl-C)")
-    live.add_argument("--idle-s", type=float, default=3.0, metavar="S",
-                      help="live: the stream has ended after S seconds without a message (3)")
+    live.add_argument("--idle-s", type=float, default=None, metavar="S",
+                      help="live: the stream has ended after S seconds without a message "
+                           "(default {idle_s:g})")
     live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
     _add_budget_arguments(p)
-    # --- issue 11: the GPS receiver's time-correlated velocity error, stated ---
+    # --- the GPS receiver's time-correlated velocity error, stated ---
     gps = p.add_argument_group("GPS velocity error (a known term of the bounds)")
     gps.add_argument("--gps-error-sigma-mps", type=float, default=None, metavar="SIGMA",
                      help="the GPS receiver's slowly varying velocity error per component, "
@@ -77,7 +79,7 @@ def add_parser(subparsers):
 
 
 def _add_budget_arguments(p):
-    """Issue 9 items 4-5: temperature/humidity inputs and the uncertainty budget's overrides."""
+    """Temperature/humidity inputs and the uncertainty budget's overrides."""
     air = p.add_argument_group("temperature and humidity")
     air.add_argument("--temp-recovery", type=float, default=1.0, metavar="R",
                      help="recovery factor of the total-temperature probe of a tat_k column, "
@@ -92,37 +94,57 @@ def _add_budget_arguments(p):
         "each given as a standard uncertainty and propagated by re-solving the perturbed "
         "flight; reported as the expanded uncertainty U (k = 2)")
     bud.add_argument("--no-budget", action="store_true",
-                     help="skip the budget (up to 14 extra solves)")
-    for flag, default, metavar, text in _BUDGET_FLAGS:
-        bud.add_argument(flag, type=float, default=default, metavar=metavar, help=text)
+                     help="skip the budget (up to {budget_solves} extra solves)")
+    for flag, metavar, text in _BUDGET_FLAGS:
+        bud.add_argument(flag, type=float, default=None, metavar=metavar, help=text)
+    p.help_from(_help_constants)
 
 
-# (flag, default, metavar, help); the defaults and their sources: estimation/budget.py
+# (flag, metavar, help); the default None leaves BudgetInputs' own, which the help quotes
 _BUDGET_FLAGS = (
-    ("--u-oat-k", 1.0, "K", "static air temperature, K; default %(default)s"),
-    ("--u-rh-percent", None, "PCT", ("relative humidity, %%RH; default 5 with a humidity, "
-                                     "else 29 (dry assumed, 0-100 %% rectangular)")),
-    ("--u-gps-velocity-mps", 0.05, "MPS", "GPS velocity bias per axis, m/s; default %(default)s"),
-    ("--u-gps-latency-s", 0.05, "S", "GPS-pressure time alignment, s; default %(default)s"),
-    ("--probe-arm-m", 0.0, "M", ("lateral offset of the pitot probe from the centre line, m "
-                                 "(right wing +): turns make it see V_t - r y; default "
-                                 "%(default)s")),
-    ("--u-qc-scale-percent", 0.1, "PCT", "transducer gain, %% of reading; default %(default)s"),
-    ("--u-qc-offset-pa", 1.0, "PA", "transducer zero offset, Pa; default %(default)s"),
+    ("--u-oat-k", "K", "static air temperature, K; default {u_oat_k:g}"),
+    ("--u-rh-percent", "PCT", ("relative humidity, %%RH; default {rh_given:g} with a humidity, "
+                               "else {rh_unknown:.0f} (dry assumed, 0-100 %% rectangular)")),
+    ("--u-gps-velocity-mps", "MPS", "GPS velocity bias per axis, m/s; default "
+                                    "{u_gps_velocity_mps:g}"),
+    ("--u-gps-latency-s", "S", "GPS-pressure time alignment, s; default {u_gps_latency_s:g}"),
+    ("--probe-arm-m", "M", ("lateral offset of the pitot probe from the centre line, m "
+                            "(right wing +): turns make it see V_t - r y; default "
+                            "{probe_arm_m:g}")),
+    ("--u-qc-scale-percent", "PCT", "transducer gain, %% of reading; default "
+                                    "{u_qc_scale_percent:g}"),
+    ("--u-qc-offset-pa", "PA", "transducer zero offset, Pa; default {u_qc_offset_pa:g}"),
 )
+
+
+def _help_constants():
+    """The library constants `identify --help` quotes (the budget re-solves each source twice)."""
+    import dataclasses
+
+    from pitotcal.estimation.identification import budget
+    from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
+    from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
+
+    defaults = dataclasses.asdict(budget.BudgetInputs())
+    return {**defaults, "u_qc_scale_percent": 100.0 * defaults["u_qc_scale"],
+            "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
+            "budget_solves": 2 * len(budget.SOURCES), "ardupilot_param": ARDUPILOT_RATIO,
+            "px4_params": " or ".join(PX4_SCALES), "px4_param": PX4_SCALES[0],
+            "idle_s": IDLE_TIMEOUT_S}
 
 
 def _budget_inputs(args):
     from pitotcal.core.checks import number
     from pitotcal.estimation.identification.budget import inputs_from_options
 
-    scale = number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0)
+    scale = (None if args.u_qc_scale_percent is None
+             else number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0) / 100.0)
     if args.u_rh_percent is not None:
         number("u_rh_percent", args.u_rh_percent, 0.0, 100.0)
     return inputs_from_options(
         u_oat_k=args.u_oat_k, u_rh_pct=args.u_rh_percent,
         u_gps_velocity_mps=args.u_gps_velocity_mps, u_gps_latency_s=args.u_gps_latency_s,
-        probe_arm_m=args.probe_arm_m, u_qc_scale=scale / 100.0,
+        probe_arm_m=args.probe_arm_m, u_qc_scale=scale,
         u_qc_offset_pa=args.u_qc_offset_pa)
 
 
@@ -152,7 +174,7 @@ def run(args):
                       gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))
     budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
 
-    # issue 15: every file is written before anything is printed, so a reader that goes
+    # every file is written before anything is printed, so a reader that goes
     # away early (`| head`) never costs a file
     if args.json is not None:
         _write_json(args.json, result, flight, source, budget, _gps_error(args), _reading(args))
@@ -162,7 +184,7 @@ def run(args):
     if args.params is not None:
         try:
             params = _write_params(args, flight, autopilot, current)
-        except PitotcalError as exc:        # said after the summary, as before
+        except PitotcalError as exc:        # said after the summary
             refused = exc
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
@@ -244,14 +266,16 @@ def _write_plot(path, result, budget):
 
 def _write_params(args, flight, autopilot, current):
     """The recommended airspeed parameter, or a PitotcalError (exit 2) saying why not."""
-    from pitotcal.estimation.reporting.autopilot_params import PARAMETER, recommend, write_parameter_file
+    from pitotcal.estimation.reporting import autopilot_params
+    from pitotcal.io.param_files import PX4_SCALES
 
-    name = next((n for n in ("ASPD_SCALE_1", "ASPD_SCALE") if n in current), None) \
-        if autopilot == "PX4" else None
-    rec = recommend(flight, autopilot, current.get(name or PARAMETER.get(autopilot, "")),
-                    gps_noise_std_mps=args.gps_noise_mps, name=name, air=args.air,
-                    **_gps_error(args))
-    write_parameter_file(rec, args.params)
+    # PX4: the scale parameter the log has (its name changed between releases)
+    name = next((n for n in PX4_SCALES if n in current), None) if autopilot == "PX4" else None
+    default = autopilot_params.PARAMETER.get(autopilot, "")
+    rec = autopilot_params.recommend(flight, autopilot, current.get(name or default),
+                                     gps_noise_std_mps=args.gps_noise_mps, name=name,
+                                     air=args.air, **_gps_error(args))
+    autopilot_params.write_parameter_file(rec, args.params)
     return rec
 
 
@@ -289,7 +313,7 @@ def _write_json(path, result, flight, source, budget=None, gps_error=None, readi
     # `identify` may carry the reader's warnings already: add only those it does not have
     given = list(out.get("warnings", []))
     out["warnings"] = given + [w for w in flight.warnings if w not in given]
-    out.update(_monitor_noise_model(result))
+    out.update(_monitor_block_stats(result))
     out.update(_gps_error_record(gps_error))
     if reading is not None:
         out["reading"] = reading
@@ -297,7 +321,7 @@ def _write_json(path, result, flight, source, budget=None, gps_error=None, readi
 
 
 def _gps_error_record(gps_error):
-    """JSON "gps_error": the stated GPS error the bounds count (issue 11), or nothing."""
+    """JSON "gps_error": the stated GPS error the bounds count, or nothing."""
     if gps_error is None:
         return {}
     return {"gps_error": {"stated": gps_error["gps_error_sigma_mps"] is not None,
@@ -305,14 +329,14 @@ def _gps_error_record(gps_error):
                           "tau_s": gps_error["gps_error_tau_s"]}}
 
 
-def _monitor_noise_model(result):
+def _monitor_block_stats(result):
     """{"noise_model": ...}: the residuals' noise model that `pitotcal monitor` designs its
-    thresholds from (estimation.monitor.model.noise_model); {} for a record too short."""
+    thresholds from; {} for a record too short."""
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.estimation.monitor.model import noise_model
+    from pitotcal.estimation.monitor.model import block_residual_stats
 
     try:
-        return {"noise_model": noise_model(result)}
+        return {"noise_model": block_residual_stats(result)}
     except PitotcalError:
         return {}
 
@@ -321,7 +345,7 @@ def _run_live(args):
     """`--live CONNECTION`: estimation.live.identify_stream, its updates on stderr."""
     import sys
 
-    from .common import check_outputs, oat_k_from_c
+    from .common import announce_stream, check_outputs, idle_timeout_s, oat_k_from_c
     from pitotcal.core.checks import choice, positive
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
@@ -350,10 +374,11 @@ def _run_live(args):
               f"{fix.dv_kt:+6.2f} +/- {fix.dv_2sigma_kt:5.2f} kt (2 sigma)  "
               f"[{fix.update_s * 1000:4.0f} ms]{flag}", file=sys.stderr)
 
+    oat_k, idle_s = oat_k_from_c(args.oat_c), idle_timeout_s(args.idle_s)
+    announce_stream("identify", args.live, idle_s)
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
-        oat_k=oat_k_from_c(args.oat_c), idle_timeout_s=positive("idle_s", args.idle_s),
-        on_fix=show, air=args.air, gps_error=_gps_error(args))
+        oat_k=oat_k, idle_timeout_s=idle_s, on_fix=show, air=args.air, gps_error=_gps_error(args))
     print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
     print(result.summary())

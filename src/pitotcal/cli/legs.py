@@ -43,8 +43,8 @@ def add_parser(subparsers):
                    help="pressure-error structure of the global fit: inverse, constant, linear; "
                         "default %(default)s")
     p.add_argument("--wind", default="per-band", metavar="MODE",
-                   help="global fit: one wind per 1,000 ft pressure-altitude band (per-band) or "
-                        "per point (per-point); default %(default)s")
+                   help="global fit: one wind per {band_ft:,.0f} ft pressure-altitude band "
+                        "(per-band) or per point (per-point); default %(default)s")
     g = p.add_argument_group("time-series input (flight CSV or log)")
     g.add_argument("--windows", metavar="T0-T1,...|WINDOWS.csv", default=None,
                    help="the legs' time windows, s ('120-180,200-260'), or a CSV with columns "
@@ -52,18 +52,22 @@ def add_parser(subparsers):
     add_reading_arguments(g)
     for flag, (key, text) in DETECT_FLAGS.items():
         g.add_argument(flag, type=float, default=None, metavar="X",
-                       help=f"{text} (default: {_default(key)})")
+                       help=f"{text} (default: {{{key}:g}})")
     g.add_argument("--point-tol-kt", type=float, default=None, metavar="KT",
-                   help="legs whose IAS differ by at most this form one point (default 3)")
+                   help="legs whose IAS differ by at most this form one point (default "
+                        "{point_tol_kt:g})")
     g.add_argument("--legs-out", metavar="LEGS.csv", default=None,
                    help="write the legs found as a leg CSV, to check by hand")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
 
 
-def _default(key):
-    # the values of estimation.legs.flight.DETECT_DEFAULTS, without importing numpy here
-    return {"min_leg_s": 30, "track_tol_deg": 3, "groundspeed_tol_kt": 3, "ias_tol_kt": 2,
-            "smooth_s": 5}[key]
+def _help_constants():
+    """The library constants `legs --help` quotes."""
+    from pitotcal.estimation.legs.flight import DETECT_DEFAULTS, POINT_TOL_KT
+    from pitotcal.estimation.legs.global_fit import BAND_FT
+
+    return {**DETECT_DEFAULTS, "point_tol_kt": POINT_TOL_KT, "band_ft": BAND_FT}
 
 
 def _is_flight(path):

@@ -30,18 +30,35 @@ def add_parser(subparsers):
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the figure (paper Fig. 15 style)")
     add_reading_arguments(p)
-    p.add_argument("--idle-s", type=float, default=3.0, metavar="S",
-                   help="live: the stream has ended after S seconds without a message (3)")
+    p.add_argument("--idle-s", type=float, default=None, metavar="S",
+                   help="live: the stream has ended after S seconds without a message "
+                        "(default {idle_s:g})")
     t = p.add_argument_group("test design")
-    t.add_argument("--false-alarms-per-hour", type=float, default=0.02, metavar="RATE",
-                   help="designed false-alarm rate per flight hour (default %(default)s)")
-    t.add_argument("--warmup-s", type=float, default=30.0, metavar="S",
+    t.add_argument("--false-alarms-per-hour", type=float, default=None, metavar="RATE",
+                   help="designed false-alarm rate per flight hour (default "
+                        "{false_alarms_per_hour:g})")
+    t.add_argument("--warmup-s", type=float, default=None, metavar="S",
                    help="seconds at the start to learn turbulence and wind, without alarms "
-                        "(default %(default)s)")
-    t.add_argument("--drift-kt-per-min", type=float, default=2.0, metavar="RATE",
+                        "(default {warmup_s:g})")
+    t.add_argument("--drift-kt-per-min", type=float, default=None, metavar="RATE",
                    help="indicated-airspeed drift the ramp test is tuned to, kt/min "
-                        "(default %(default)s)")
+                        "(default {drift_kt_per_min:g})")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
+
+
+# the test-design flags; a flag not given leaves MonitorOptions' own default
+_DESIGN_FLAGS = ("false_alarms_per_hour", "warmup_s", "drift_kt_per_min")
+
+
+def _help_constants():
+    """The monitor's defaults, which `monitor --help` quotes."""
+    import dataclasses
+
+    from pitotcal.estimation.monitor.cusum import MonitorOptions
+    from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
+
+    return {**dataclasses.asdict(MonitorOptions()), "idle_s": IDLE_TIMEOUT_S}
 
 
 def _read_calibration(path):
@@ -76,8 +93,7 @@ def run(args):
     import sys
     import warnings
 
-    from .common import check_outputs, oat_k_from_c
-    from pitotcal.core.checks import positive
+    from .common import announce_stream, check_outputs, idle_timeout_s, oat_k_from_c
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor.monitoring import monitor
     from pitotcal.estimation.monitor.cusum import MonitorOptions
@@ -91,20 +107,20 @@ def run(args):
                                (args.calibration, "the input calibration")],
                               figures=["--plot"])["--plot"]
     cal = _read_calibration(args.calibration)
-    opts = MonitorOptions(false_alarms_per_hour=args.false_alarms_per_hour,
-                          warmup_s=args.warmup_s,
-                          drift_kt_per_min=args.drift_kt_per_min).checked()
+    opts = MonitorOptions(**{name: getattr(args, name) for name in _DESIGN_FLAGS
+                             if getattr(args, name) is not None}).checked()
     if is_connection(args.source):
-        result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k_from_c(args.oat_c),
-                                     idle_timeout_s=positive("idle_s", args.idle_s),
+        oat_k, idle_s = oat_k_from_c(args.oat_c), idle_timeout_s(args.idle_s)
+        announce_stream("monitor", args.source, idle_s)
+        result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k, idle_timeout_s=idle_s,
                                      on_status=lambda text: print(text, file=sys.stderr))
         flight = buf.flight()
-        _check_warmup(flight, args.warmup_s)
+        _check_warmup(flight, opts.warmup_s)
     else:
         flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
                              oat_k=oat_k_from_c(args.oat_c))
         result = monitor(flight, cal, opts)      # a flight too short for it is said there
-        _check_warmup(flight, args.warmup_s)
+        _check_warmup(flight, opts.warmup_s)
     for message in result.warnings:
         warnings.warn(message, stacklevel=2)
     out = result.to_dict()

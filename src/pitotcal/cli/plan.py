@@ -14,7 +14,7 @@ def add_parser(subparsers):
         "plan", help="plan a calibration maneuver (CasADi/IPOPT)",
         description="Plan a calibration maneuver: the airspeed schedule holds q uniform (or in "
                     "equal steps), the optimised ground track stays inside the radius in the "
-                    "wind and turns through every 30° heading sector in each third of the q "
+                    "wind and turns through a full 360° of heading in each third of the q "
                     "range. Writes PLAN.csv and beside it PLAN.card.txt/.card.png (pilot "
                     "card), PLAN.autothrottle.csv and PLAN.png (plan figure).")
     p.add_argument("--profile", choices=PROFILES, default=None,
@@ -27,19 +27,20 @@ def add_parser(subparsers):
         p.add_argument(f"--{name}", type=float, default=T2_PLAN[name.replace("-", "_")],
                        metavar=unit.split()[0], help=f"{unit} (default: %(default)g)")
     p.add_argument("--roll-rate-max-dps", type=float, default=None, metavar="DEG/S",
-                   help="roll-rate limit (default: 10)")
+                   help="roll-rate limit (default: {roll_rate_max_dps:g})")
     p.add_argument("--accel-max-mps2", type=float, default=None, metavar="M/S2",
-                   help="acceleration limit (default: 1)")
-    p.add_argument("--levels", type=int, default=None, help="step-pause levels (default: 4)")
+                   help="acceleration limit (default: {accel_max_mps2:g})")
+    p.add_argument("--levels", type=int, default=None, help="step-pause levels (default: {levels})")
     p.add_argument("--return", dest="return_leg", action="store_true",
                    help="continuous profile: sweep back down to --cas-min-kt")
     p.add_argument("--turn", choices=(*TURNS, "both"), default=TURNS[0],
                    help="turn direction; both: right and left orbits alternate from one "
                         "speed group to the next, so a probe lever-arm term averages out "
                         "(default: %(default)s)")
-    p.add_argument("--dt-s", type=float, default=1.0, help="plan node spacing (default: 1 s)")
+    p.add_argument("--dt-s", type=float, default=1.0,
+                   help="plan node spacing, s (default: %(default)g)")
     p.add_argument("--max-iter", type=int, default=None, metavar="N",
-                   help="IPOPT iteration limit (default: 300)")
+                   help="IPOPT iteration limit (default: {max_iter})")
     p.add_argument("--no-figures", action="store_true", help="skip the PNG files")
     p.add_argument("--center", nargs=2, type=float, default=None, metavar=("LAT", "LON"),
                    help="test-area centre, degrees WGS-84: the card gives coordinates and "
@@ -58,7 +59,21 @@ def add_parser(subparsers):
                    help="a prior `identify --json` result: the card adds the KIAS the "
                         "uncalibrated indicator shows at each KCAS target")
     p.add_argument("-o", "--output", required=True, metavar="PLAN.csv", help="plan CSV to write")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
+
+
+def _help_constants():
+    """The planner's defaults, which `plan --help` quotes."""
+    from pitotcal.core.dynamics import Limits
+    from pitotcal.maneuvers.plan.design import STALL_DEFAULT_RATIO
+    from pitotcal.maneuvers.plan.design_request import DesignOptions
+    from pitotcal.maneuvers.plan.planner import MAX_ITER
+    from pitotcal.maneuvers.plan.request import PlanRequest
+
+    defaults = {**dataclasses.asdict(Limits()), **dataclasses.asdict(DesignOptions())}
+    return {**defaults, "max_iter": MAX_ITER, "stall_ratio": STALL_DEFAULT_RATIO,
+            "levels": PlanRequest().levels}
 
 
 def run(args):
@@ -152,24 +167,24 @@ _DESIGN_FIELDS = ("turbulence_mps", "criterion", "target_2sigma_kt", "stall_kt",
 def _add_design_arguments(p):
     p.add_argument("--design", choices=("paper", "optimal"), default="paper",
                    help="paper: --profile's schedule; optimal: the speed schedule that "
-                        "minimises the predicted 2σ of ΔV in turbulence (default: paper)")
+                        "minimises the predicted 2σ of ΔV in turbulence (default: %(default)s)")
     g = p.add_argument_group("optimal design (with --design optimal)")
     g.add_argument("--turbulence-mps", type=float, default=None, metavar="M/S",
-                   help="RMS gust the design is for (default: 0.5)")
+                   help="RMS gust the design is for, m/s (default: {turbulence_mps:g})")
     g.add_argument("--criterion", choices=("worst", "average"), default=None,
                    help="minimise the worst or the mean 2σ of ΔV over the range "
-                        "(default: worst)")
+                        "(default: {criterion})")
     g.add_argument("--target-2sigma-kt", type=float, default=None, metavar="KT",
                    help="plan the shortest flight whose predicted 2σ of ΔV meets this "
                         "(replaces --duration-s)")
     g.add_argument("--stall-kt", type=float, default=None, metavar="KCAS",
-                   help="stall speed (default: --cas-min-kt / 1.3)")
+                   help="stall speed (default: --cas-min-kt / {stall_ratio:g})")
     g.add_argument("--stall-margin", type=float, default=None, metavar="X",
                    help="cas-min must be X times the stall speed at the turn's load factor; "
-                        "limits the bank (default: 1.2)")
+                        "limits the bank (default: {stall_margin:g})")
     g.add_argument("--check-fraction", type=float, default=None, metavar="F",
                    help="dwell share of the middle speed that checks the model structure "
-                        "(default: 0.1; 0: two speeds only)")
+                        "(default: {check_fraction:g}; 0: two speeds only)")
 
 
 def _request(args, max_iter):
@@ -238,7 +253,7 @@ def _calibration(path):
                             f"parameters.k*.value needed; {type(exc).__name__}: {exc})") from None
     if not all(abs(v) < float("inf") for v in k):
         raise PitotcalError(f"--calibration {path}: coefficients must be finite, got {k}")
-    air = result.get("air_data", "incompressible")   # results before issue 9: incompressible
+    air = result.get("air_data", "incompressible")   # a result without air_data: incompressible
     if air not in ("compressible", "incompressible"):
         raise PitotcalError(f"--calibration {path}: air_data {air!r} is not compressible or "
                             "incompressible")

@@ -1,4 +1,4 @@
-"""`pitotcal report`: the calibration report, one self-contained HTML file (issue 10).
+"""`pitotcal report`: the calibration report, one self-contained HTML file.
 
 Exit status: 0 written; 2 unusable input (result JSON, flight, aircraft TOML, options), one
 stderr line naming the file or flag.
@@ -33,8 +33,9 @@ def add_parser(subparsers):
     p.add_argument("--aircraft", metavar="AIRCRAFT.toml", default=None,
                    help="title block: [aircraft] type, registration, configuration, weight, cg; "
                         "[test] date, location, pilot, engineer, notes")
-    p.add_argument("--regulation", default="23.1323", metavar="R",
-                   help="23.1323, 25.1323 or none (default %(default)s)")
+    p.add_argument("--regulation", default=REGULATION_CHOICES[0], metavar="R",
+                   help=f"{', '.join(REGULATION_CHOICES[:-1])} or {REGULATION_CHOICES[-1]} "
+                        "(default %(default)s)")
     p.add_argument("--speed-range-kt", nargs=2, type=float, default=None, metavar=("LO", "HI"),
                    help="calibrated-airspeed range for the verdict, KCAS (default: the flown "
                         "range, and the report says so; speeds not flown are not demonstrated)")

@@ -12,10 +12,10 @@ def add_parser(subparsers):
                     "and FLIGHT.truth.json beside it. The same seed gives the same file.")
     p.add_argument("plan", help="plan CSV (pitotcal plan)")
     p.add_argument("-o", "--output", required=True, help="flight CSV to write")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default %(default)s)")
     g = p.add_argument_group("truth")
     g.add_argument("--model", default="inverse",
-                   help=f"pressure-error structure: {', '.join(TRUE_K)} (default inverse)")
+                   help=f"pressure-error structure: {', '.join(TRUE_K)} (default %(default)s)")
     k1, k2 = true_k("inverse")
     g.add_argument("--k1", type=float, help=f"true k1 (default {k1:g})")
     g.add_argument("--k2", type=float, help=f"true k2 (default {k2:g} Pa for inverse)")
@@ -24,39 +24,45 @@ def add_parser(subparsers):
                    help="mean wind FROM, deg true, 0-360 (default: the plan's)")
     g.add_argument("--wind-drift-n-mps2", type=float, default=0.0, help="wind drift north, m/s^2")
     g.add_argument("--wind-drift-e-mps2", type=float, default=0.0, help="wind drift east, m/s^2")
-    g.add_argument("--turbulence-mps", type=float, default=0.5, help="Dryden horizontal RMS (0.5)")
+    g.add_argument("--turbulence-mps", type=float, default=0.5,
+                   help="Dryden horizontal RMS (%(default)g)")
     g.add_argument("--turbulence-length-m", type=float, help="gust scale length (MIL-F-8785C)")
     s = p.add_argument_group("sensors")
-    s.add_argument("--rate-hz", type=float, default=50.0, help="sample rate (50)")
-    s.add_argument("--qc-noise-pa", type=float, default=0.5, help="transducer noise std (0.5)")
-    s.add_argument("--qc-quantization-pa", type=float, default=0.0, help="converter step (0)")
-    s.add_argument("--qc-bias-pa", type=float, default=0.0, help="transducer bias (0)")
-    s.add_argument("--qc-scale-error", type=float, default=0.0, help="relative gain error (0)")
-    s.add_argument("--pneumatic-lag-s", type=float, default=0.0, help="tubing lag (0)")
+    s.add_argument("--rate-hz", type=float, default=50.0, help="sample rate (%(default)g)")
+    s.add_argument("--qc-noise-pa", type=float, default=0.5,
+                   help="transducer noise std (%(default)g)")
+    s.add_argument("--qc-quantization-pa", type=float, default=0.0,
+                   help="converter step (%(default)g)")
+    s.add_argument("--qc-bias-pa", type=float, default=0.0, help="transducer bias (%(default)g)")
+    s.add_argument("--qc-scale-error", type=float, default=0.0,
+                   help="relative gain error (%(default)g)")
+    s.add_argument("--pneumatic-lag-s", type=float, default=0.0, help="tubing lag (%(default)g)")
     s.add_argument("--gps-rate-hz", type=float, default=5.0,
-                   help="GPS update rate, 0 = every sample (5)")
+                   help="GPS update rate, 0 = every sample (%(default)g)")
     s.add_argument("--gps-noise-mps", type=float, default=0.05,
-                   help="GPS velocity noise std (0.05)")
-    s.add_argument("--gps-latency-s", type=float, default=0.0, help="GPS velocity latency (0)")
+                   help="GPS velocity noise std (%(default)g)")
+    s.add_argument("--gps-latency-s", type=float, default=0.0,
+                   help="GPS velocity latency (%(default)g)")
     s.add_argument("--gps-gm-sigma-mps", type=float, default=0.0,
                    help="time-correlated (Gauss-Markov) GPS velocity error std, m/s (0: none)")
     s.add_argument("--gps-gm-tau-s", type=float, default=30.0,
-                   help="its correlation time, s (30)")
+                   help="its correlation time, s (%(default)g)")
+    # Dryden's vertical gust flown (plunge, altitude, GPS climb, V_t)
     s.add_argument("--vertical-gusts", action="store_true",
                    help="fly the vertical gust too: the aircraft plunges with it and the "
                         "airspeed includes the air-relative climb (own engine; JSBSim's "
                         "turbulence always has it)")
     g.add_argument("--air-data", default=None,
                    help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
-                        "the paper's eq. 2; default) or compressible (isentropic, ISA p and T); "
-                        "JSBSim's is always compressible")
+                        "the paper's eq. 2) or compressible (isentropic, ISA p and T); default "
+                        "{air_data}; JSBSim's is always compressible")
     e = p.add_argument_group("flight model")
     e.add_argument("--engine", default="own", choices=("own", "jsbsim"),
                    help="own: pitotcal's point-mass model (fast, default); jsbsim: the JSBSim "
                         "six-degree-of-freedom model, its atmosphere and Milspec turbulence")
     e.add_argument("--aircraft", default=None,
-                   help="JSBSim aircraft (default c172x, the Cessna 172); --engine jsbsim only")
-    f = p.add_argument_group("fault (maneuvers.fly.faults)")
+                   help="JSBSim aircraft (default {aircraft}); --engine jsbsim only")
+    f = p.add_argument_group("fault (a sensor failure injected into the flight)")
     f.add_argument("--fault", metavar="KIND:ONSET_S:SIZE", default=None,
                    help="spoil the pitot-static record from ONSET_S on: blocked (SIZE drain "
                         "time constant s, 0 frozen), static (SIZE s, 0 sealed), leak (SIZE "
@@ -77,12 +83,20 @@ def add_parser(subparsers):
                    help="bias of the logged temperature, K")
     a.add_argument("--gps-bias-mps", type=float, nargs=3, default=None, metavar=("N", "E", "D"),
                    help="constant GPS velocity bias north, east, down, m/s")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
-    return p
+
+
+def _help_constants():
+    """The simulator's defaults, which `simulate --help` quotes."""
+    from pitotcal.maneuvers.fly.jsbsim_engine import DEFAULT_AIRCRAFT
+    from pitotcal.maneuvers.fly.options import ENGINE_AIR_DATA
+
+    return {"air_data": ENGINE_AIR_DATA["own"], "aircraft": DEFAULT_AIRCRAFT}
 
 
 def _air_sensors(args):
-    """The `air_sensors` dict of the options given, or None (then the files are as before)."""
+    """The `air_sensors` dict of the options given, or None (no air-data sensors simulated)."""
     given = {"tat_recovery": args.tat_recovery, "rh_pct": args.rh_percent,
              "probe_arm_m": args.probe_arm_m, "oat_bias_k": args.oat_bias_k,
              "gps_bias_mps": None if args.gps_bias_mps is None else tuple(args.gps_bias_mps)}

@@ -19,23 +19,33 @@ def add_parser(subparsers):
                    help="Monte Carlo replicates per case (coverage: number of flights); "
                         "default: the study's own")
     p.add_argument("--out", dest="out_dir", default=".", metavar="DIR",
-                   help="output folder (default: .)")
+                   help="output folder (default: %(default)s)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="address of an existing Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--workers", type=int, default=None,
                    help="local worker processes (default: all cores; 0: run in this process)")
-    p.add_argument("--seed", type=int, default=0, help="base seed; run i uses the table's seed")
+    p.add_argument("--seed", type=int, default=0,
+                   help="base seed; run i uses the table's seed (default %(default)s)")
     p.add_argument("--quick", action="store_true", help="small grid (smoke runs, CI)")
     p.add_argument("--data", dest="data_dir", default=None, metavar="DIR",
                    help="real-alfa: folder of the ALFA flight CSVs (default: "
-                        "$PITOTCAL_ALFA_DATA, else ./alfa-carbonz)")
+                        "${alfa_env}, else ./{alfa_dir})")
     p.add_argument("--engine", default="own", choices=("own", "jsbsim"),
                    help="flight model of the simulated runs: own (default) or jsbsim "
-                        "(JSBSim's c172x; the coverage and noise studies)")
+                        "(JSBSim's {aircraft}; the coverage and noise studies)")
     p.add_argument("--run-index", type=int, default=None, metavar="I",
                    help="repeat run I alone (same --runs/--seed/--quick as the study); "
                         "prints its rows as JSON")
+    p.help_from(_help_constants)
     p.set_defaults(run=run)
+
+
+def _help_constants():
+    """The constants `study --help` quotes."""
+    from pitotcal.io.alfa import ALFA_DATA_ENV, ALFA_DIR_NAME
+    from pitotcal.maneuvers.fly.jsbsim_engine import DEFAULT_AIRCRAFT
+
+    return {"alfa_env": ALFA_DATA_ENV, "alfa_dir": ALFA_DIR_NAME, "aircraft": DEFAULT_AIRCRAFT}
 
 
 def run(args):

@@ -62,7 +62,7 @@ class Flight:
     meta: dict = field(default_factory=dict)
     n_dropped: int = 0
     warnings: tuple = ()
-    # issue 9 (temperature and humidity): optional channels
+    # temperature and humidity: optional channels
     tat_k: np.ndarray | None = None
     rh_pct: np.ndarray | None = None
 

@@ -52,7 +52,7 @@ __all__ = [
 # + 0.5 m/s turbulence, Gauss-Markov GPS in calm air, T-2 in 1 m/s turbulence): the covariance
 # module's one per 4 made k1/k2 1.2-1.5x too wide (rms z 0.6-0.9), none left the wind of the
 # Gauss-Markov case at 85% coverage. Re-measured on 100 flights each of the own simulator and
-# JSBSim in 1 m/s turbulence (issue 11, docs/measured.md): one per 1 gives k1/k2 rms z
+# JSBSim in 1 m/s turbulence (docs/measured.md): one per 1 gives k1/k2 rms z
 # 1.04 / 1.00 and 0.89 / 0.87; one per 1/4 1.12 / 1.07 and 0.94 / 0.91.
 DOF_TAUS = 1.0
 
@@ -128,8 +128,8 @@ def residual_covariance(time_s, tas_mps, rho_kgm3, noise, *, stationary=True):
     The white parts are scaled to the grid spacing dt: a sample on the grid stands for
     dt * rate_hz transducer samples (variance / that count) and for dt * gps_rate_hz GPS fixes.
     `stationary` (default) gives every sample the flight's mean-square gust pressure
-    rho^2 <V^2> sigma_u^2 (one autocovariance for all residuals, as the estimator's noise model
-    was before its velocity terms); False keeps rho^2 V_i^2 sigma_u^2 at each sample. The
+    rho^2 <V^2> sigma_u^2 (one autocovariance for all residuals: a stationary noise model without
+    velocity terms); False keeps rho^2 V_i^2 sigma_u^2 at each sample. The
     design scores with `reported_covariance`.
     """
     both = residual_covariances(time_s, tas_mps, rho_kgm3, noise)

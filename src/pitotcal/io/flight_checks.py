@@ -22,7 +22,7 @@ QCI_MIN_FLYING_PA = 20.0     # 0.5 * 1.225 * (11 kt)^2: nothing that flies is sl
 # `Flight.alt_m`, not a reason to drop the row or reject the file.
 INFORMATIVE = ("alt_m",)
 _POSITIVE = ("qc_pa", "rho_kgm3", "ps_pa", "oat_k", "ps_ref_pa")
-# Issue 15: a cell outside these bounds is no measurement of a flying aircraft (a logger
+# A cell outside these bounds is no measurement of a flying aircraft (a logger
 # glitch, a corrupt cell): unusable like NaN. GNSS receivers stop reporting velocity above
 # 515 m/s (the COCOM limit, 1000 kt); 2e5 Pa is the impact pressure of Mach 1.6 at sea level;
 # 2.5 kg/m^3 and 1.2e5 Pa are beyond any air at any airfield (ISA -90 degC at 1.08 bar is
@@ -254,7 +254,7 @@ def check_units(name, qci, vn, ve, rho):
         "m/s; check their units")
 
 
-# Issue 15: the time column's unit. A calibration flight is sampled at 0.5-1000 Hz: a median
+# The time column's unit. A calibration flight is sampled at 0.5-1000 Hz: a median
 # step above 2 "s" is a log in milliseconds or microseconds; a first time after 1e8 s (1973)
 # is a clock (Unix time), not seconds since the log started.
 _TIME_STEP_MAX_S = 2.0

@@ -80,16 +80,12 @@ PLAN_NOT_FLIGHT = ("this is a plan (the columns of pitotcal plan), not a flight:
 
 
 def write_flight_csv(flight, path, comments=None):
-    """Write `flight` as a flight CSV (docs/interfaces.md §1): `# key: value` lines, header, rows.
-
-    Density is written as `rho_kgm3`; the optional columns only when present.
-    """
-    columns = ["time_s", "qc_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3"]
-    data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3]
-    for name in ("gps_vd_mps", "alt_m", "ps_pa", "oat_k", "ps_ref_pa", *TEMPERATURE_COLUMNS):
-        if getattr(flight, name) is not None:
-            columns.append(name)
-            data.append(getattr(flight, name))
+    """Write `flight` as a flight CSV (docs/interfaces.md §1): `# key: value` lines, header, rows;
+    the columns WRITTEN_COLUMNS, then those of WRITTEN_IF_PRESENT the flight has."""
+    optional = [name for name in WRITTEN_IF_PRESENT if getattr(flight, name) is not None]
+    columns = [*WRITTEN_COLUMNS, *optional]
+    data = [flight.time_s, flight.qci_pa, flight.gps_vn_mps, flight.gps_ve_mps, flight.rho_kgm3,
+            *(getattr(flight, name) for name in optional)]
     meta = {**flight.meta, **(comments or {})}
     header = "".join(f"# {key}: {value}\n" for key, value in meta.items()) + ",".join(columns)
     with atomic_open(path, "w") as fh:          # whole or not at all: never a spliced file
@@ -105,8 +101,11 @@ OPTIONAL_COLUMNS = ("gps_vd_mps", "alt_m", "ps_ref_pa")
 # Static pressure (the static source's reading) and temperature: density when rho_kgm3 is
 # absent, and the compressible calibration's air data whenever both are present.
 STATIC_COLUMNS = ("ps_pa", "oat_k")
-# issue 9 item 4: total air temperature and humidity, converted by core.moist_air
+# total air temperature and humidity, converted by core.moist_air
 TEMPERATURE_COLUMNS = ("tat_k", "rh_pct")
+# The columns `write_flight_csv` writes, in order (the optional ones: Flight fields it has)
+WRITTEN_COLUMNS = (*REQUIRED_COLUMNS, "rho_kgm3")
+WRITTEN_IF_PRESENT = ("gps_vd_mps", "alt_m", *STATIC_COLUMNS, "ps_ref_pa", *TEMPERATURE_COLUMNS)
 MIN_ROWS = 10
 
 
@@ -156,7 +155,7 @@ def read_flight_csv(path, start_s=None, end_s=None):
             check_ps_oat(name, data[:, col["ps_pa"]], temperature)
         rho = density_kgm3(data[:, col["ps_pa"]], temperature)
     check_units(name, qci, vn, ve, rho)
-    # issue 15: no implausible cell left, the units of time and of the vertical speed
+    # no implausible cell left, the units of time and of the vertical speed
     check_plausible(name, table, data, rows, use)
     clock = check_time_units(name, time_s)
     if "gps_vd_mps" in col:
@@ -171,7 +170,7 @@ def read_flight_csv(path, start_s=None, end_s=None):
                     rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
                     n_dropped=n_dropped, warnings=tuple(w for w in (warning, clock) if w),
                     **optional)
-    return with_static_air(flight)          # issue 9: tat_k, rh_pct (core.moist_air)
+    return with_static_air(flight)          # tat_k, rh_pct (core.moist_air)
 
 
 def csv_kind(path):
@@ -298,7 +297,7 @@ def _used_columns(name, columns):
         density = ["rho_kgm3"] + static
     elif static:
         density = static
-    elif "ps_pa" in present and "tat_k" in present:      # issue 9: total temperature
+    elif "ps_pa" in present and "tat_k" in present:      # total temperature
         density = ["ps_pa", "tat_k"]
     else:
         found = [c for c in ("ps_pa", "oat_k") if c in present]
@@ -306,7 +305,7 @@ def _used_columns(name, columns):
         raise FlightDataError(f"{name}: missing column for density: needs rho_kgm3, or both "
                               f"ps_pa and oat_k{also}")
     use = list(REQUIRED_COLUMNS) + density + [c for c in OPTIONAL_COLUMNS if c in present]
-    if present & set(TEMPERATURE_COLUMNS):      # issue 9: and what converting them needs
+    if present & set(TEMPERATURE_COLUMNS):      # and what converting them needs
         use += [c for c in ("ps_pa", *TEMPERATURE_COLUMNS) if c in present and c not in use]
     for c in use:
         if columns.count(c) > 1:

@@ -75,7 +75,11 @@ from .flightlog import AutopilotWind, FlightLog
 from .streams import LOG_EXTENSIONS
 from .timebase import apply_cuts, clean, gps_onto, spans
 
-__all__ = ["AutopilotWind", "FlightLog", "load_log", "read_log"]
+__all__ = ["LOG_COLUMNS", "AutopilotWind", "FlightLog", "load_log", "read_log"]
+
+# The optional flight columns a log's flight carries (`load_log`): the static pressure and its
+# temperature always, the GPS climb rate and altitude when the log records them.
+LOG_COLUMNS = ("ps_pa", "oat_k", "gps_vd_mps", "alt_m")
 
 log = logging.getLogger(__name__)
 
@@ -224,7 +228,7 @@ def _assemble(s, name, start_s, end_s, opt):
             f"q_ci < {opt.min_q:g} Pa": q < opt.min_q}
     cuts.update(slow)
     cuts["non-finite density"] = ~np.isfinite(rho) | (rho <= 0)
-    # issue 15: a logger glitch (1e200 in a GPS velocity) is cut, never fitted
+    # a logger glitch (1e200 in a GPS velocity) is cut, never fitted
     cuts["implausible value"], glitch = implausible_samples(
         name, t, qc_pa=q, gps_vn_mps=gps.vn, gps_ve_mps=gps.ve, rho_kgm3=rho,
         gps_vd_mps=gps.vd if s.gps_vd is not None else None)
@@ -303,7 +307,7 @@ def _density(s, t, alt, oat_k):
         temp_source = f"{s.temp_source}: sensor temperature, not OAT"
         s.conversions.append(f"no outside air temperature in the log: density uses "
                              f"{s.temp_source}, a sensor temperature, not OAT "
-                             "(pass oat_k, or --oat-c)")
+                             "(give the outside air temperature, `oat_k`)")
     else:
         temp = isa_temperature_k(alt)
         temp_source = "ISA at GPS altitude (no temperature in the log)"

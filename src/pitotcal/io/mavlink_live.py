@@ -25,9 +25,16 @@ from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.flight import Flight
 from pitotcal.core.units import density_kgm3
 
-__all__ = ["CONNECTION_PREFIXES", "MavlinkFlightBuffer", "is_connection", "read_stream"]
+__all__ = ["CONNECTION_PREFIXES", "FIRST_MESSAGE_TIMEOUT_S", "IDLE_TIMEOUT_S",
+           "LISTENING_PREFIXES", "MavlinkFlightBuffer", "is_connection", "read_stream"]
 
 CONNECTION_PREFIXES = ("udp:", "udpin:", "udpout:", "tcp:", "tcpin:")
+# pymavlink's connections that wait for the sender (the others connect to it)
+LISTENING_PREFIXES = ("udp:", "udpin:", "tcpin:")
+# How long a stream may take to send its first message, s, before reading gives up
+FIRST_MESSAGE_TIMEOUT_S = 30.0
+# A stream has ended when nothing arrives for this long after its first message, s
+IDLE_TIMEOUT_S = 3.0
 _MESSAGES = ["SCALED_PRESSURE", "GLOBAL_POSITION_INT"]
 _RECEIVE_BUFFER_BYTES = 8 << 20
 
@@ -77,7 +84,7 @@ class MavlinkFlightBuffer:
             out.append(f"{self.source}: {self.n_out_of_order} out-of-order samples dropped")
         if self.rows and self.oat_k is None:
             out.append(f"{self.source}: density from the pressure sensor's own temperature "
-                       f"(not OAT; give --oat-c)")
+                       f"(not OAT; give the outside air temperature, `oat_k`)")
         return out
 
     def flight(self):
@@ -110,8 +117,8 @@ def _connect(source):
     return conn
 
 
-def read_stream(source, *, oat_k=None, idle_timeout_s=3.0, first_timeout_s=30.0,
-                every_s=1.0, on_tick=None, max_s=None):
+def read_stream(source, *, oat_k=None, idle_timeout_s=IDLE_TIMEOUT_S,
+                first_timeout_s=FIRST_MESSAGE_TIMEOUT_S, every_s=1.0, on_tick=None, max_s=None):
     """Read a MAVLink stream until it stops; the `MavlinkFlightBuffer` of what arrived.
 
     Parameters

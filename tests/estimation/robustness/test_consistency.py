@@ -59,7 +59,7 @@ def test_one_way_sweep_says_it_cannot_tell(sweep):
     note = [w for w in result.warnings if HIDES in w]
     assert len(note) == 1, result.warnings
     assert f"t = {hidden['onset_s']:.0f} s" in note[0]
-    assert f"{100 * hidden['step']:.1f}% up" in note[0] and "plan --return" in note[0]
+    assert f"{100 * hidden['step']:.1f}% up" in note[0] and "plan a return sweep" in note[0]
     # in the JSON, strict
     out = json.loads(json.dumps(result.to_dict(), allow_nan=False))
     assert out["consistency"]["undetected"]["power"] == consistency.POWER

@@ -88,7 +88,7 @@ def test_table_comments_and_leading_columns(tmp_path):
 
 @pytest.mark.parametrize("address", ["nonsense", "tcp://127.0.0.1"])
 def test_bad_scheduler_address_is_one_line_error(address):
-    with pytest.raises(ValueError, match=f"--scheduler '{address}': cannot connect"):
+    with pytest.raises(ValueError, match=f"`scheduler` '{address}': cannot connect"):
         run_cases(echo_task, _cases(2), scheduler=address)
 
 
@@ -120,5 +120,5 @@ def test_a_port_that_is_not_dask_is_one_line_error_not_a_hang(not_dask_port, mon
 
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1.0)
     address = f"tcp://127.0.0.1:{not_dask_port}"
-    with pytest.raises(ValueError, match=f"--scheduler '{address}': cannot connect"):
+    with pytest.raises(ValueError, match=f"`scheduler` '{address}': cannot connect"):
         run_cases(echo_task, _cases(2), scheduler=address)

@@ -9,12 +9,12 @@ _CACHE = {}
 
 
 @pytest.fixture
-def alfa_summary(shared_data, tmp_path_factory):
+def alfa_summary(shared_file, tmp_path_factory):
     """The study run once per module (it takes ~2 s), skipped without the shared data."""
     if "run" not in _CACHE:
         out = tmp_path_factory.mktemp("real-alfa")
         _CACHE["run"] = (run_study("real-alfa", out_dir=out,
-                                   data_dir=shared_data / "alfa-carbonz"), out)
+                                   data_dir=shared_file("alfa-carbonz")), out)
     return _CACHE["run"]
 
 
