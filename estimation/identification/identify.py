@@ -7,7 +7,7 @@ import logging
 import numpy as np
 
 from pitotcal.core import checks
-from pitotcal.core.airdata import AIR_DATA_MODES
+from pitotcal.core.measurement import AIR_DATA_MODES
 from pitotcal.core.errors import FlightDataError, ObservabilityError, PitotcalError
 from pitotcal.core.models import MODELS, get_model
 

@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from pitotcal.core.airdata import AIR_DATA_MODES
+from pitotcal.core.measurement import AIR_DATA_MODES
 from pitotcal.core.checks import choice, exact, number, positive, round_to_limit
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model

@@ -37,7 +37,6 @@ from .units import (
 
 __all__ = [
     "A0_MPS",
-    "AIR_DATA_MODES",
     "GAMMA",
     "P0_PA",
     "PRESSURE_ALTITUDE_MAX_M",
@@ -60,8 +59,6 @@ __all__ = [
     "static_pressure_pa",
 ]
 
-# How impact pressure follows from true airspeed: the paper's eq. 2 (½ρV_t²) or isentropic.
-AIR_DATA_MODES = ("incompressible", "compressible")
 GAMMA = 1.4
 P0_PA = ISA_P0_PA
 T0_K = ISA_T0_K

@@ -18,6 +18,7 @@ from plans import circle_plan
 from pitotcal.core import airdata as ad
 from pitotcal.core import units
 from pitotcal.core.errors import PitotcalError
+from pitotcal.core.measurement import AIR_DATA_MODES
 from pitotcal.core.models import get_model
 
 ALT_M = 3048.0                                        # 10,000 ft
@@ -34,7 +35,7 @@ def fast_plan():
 @pytest.fixture(scope="module")
 def fits(fast_plan):
     out = {}
-    for mode in ad.AIR_DATA_MODES:
+    for mode in AIR_DATA_MODES:
         flight, truth = simulate(fast_plan, seed=3, turbulence_mps=0.0, rate_hz=10.0,
                                  air_data=mode, keep_history=True)
         out[mode] = flight, truth, identify(flight, model="inverse", air="incompressible")
