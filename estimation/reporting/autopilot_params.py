@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pitotcal.core.errors import ObservabilityError, PitotcalError
+from pitotcal.core.measurement import DEFAULT_AIR_DATA
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import RHO0_KGM3
 
@@ -96,7 +97,7 @@ class ParameterRecommendation:
         return lines + list(self.notes)
 
 
-def recommend(flight, autopilot, current=None, *, name=None, air="compressible",
+def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DATA,
               **noise):
     """The airspeed parameter for `autopilot` from `flight`, or a refusal.
 

@@ -9,7 +9,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from pitotcal.core.measurement import AIR_DATA_MODES
+from pitotcal.core.measurement import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from pitotcal.core.checks import choice, exact, number, positive, round_to_limit
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model
@@ -86,7 +86,7 @@ class SimOptions:
     gps_rate_hz: float
     gps_noise_mps: float
     gps_latency_s: float
-    air_data: str = "incompressible"
+    air_data: str = DEFAULT_AIR_DATA
     air_sensors: "AirSensors | None" = None
     # Gauss-Markov GPS velocity error (issue 11): steady-state sigma (m/s; 0 none), tau (s)
     gps_gm_sigma_mps: float = 0.0
@@ -237,7 +237,7 @@ def _true_k(model, k):
 def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, turbulence_mps,
              turbulence_length_m, rate_hz, qc_noise_pa, qc_quantization_pa, qc_bias_pa,
              qc_scale_error, pneumatic_lag_s, gps_rate_hz, gps_noise_mps, gps_latency_s,
-             air_data="incompressible", sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
+             air_data=DEFAULT_AIR_DATA, sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
              vertical_gusts=False):
     """`SimOptions` from `simulate`'s arguments (see there): each checked, naming the parameter,
     the wind's defaults filled from the plan's settings, sizes checked against the plan."""

@@ -38,18 +38,15 @@ from .truth import (
 )
 from ..turbulence import dryden_gusts, dryden_scales
 
-from pitotcal.core.airdata import qc_from_tas_sq_pa
 from pitotcal.core.checks import integer
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.flight import Flight
-from pitotcal.core.measurement import impact_pressure_pa
+from pitotcal.core.measurement import DEFAULT_AIR_DATA, StaticAir, isa_air
 from pitotcal.core.models import get_model
 from pitotcal.core.units import (
     G0_MPS2,
     RHO0_KGM3,
     isa_density_kgm3,
-    isa_pressure_pa,
-    isa_temperature_k,
     mps_to_kt,
     wind_polar,
     wind_vector_mps,
@@ -204,16 +201,15 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
         climb_air = (np.gradient(alt, dt) if n > 1 else np.zeros(n)) - w_up_mps
         v_air = np.sqrt(tas ** 2 + climb_air ** 2)
     rho = isa_density_kgm3(alt)
+    # the true air at the ISA state flown (`core.measurement`): what the probe and port see
+    true_air = isa_air(alt, opts.air_data)
+    qc = true_air.qc_pa(v_air ** 2)
     static = {}
-    if opts.air_data == "compressible":
-        # isentropic, at the ISA static pressure and temperature rho is made of
-        ps, oat = isa_pressure_pa(alt), isa_temperature_k(alt)
-        qc = qc_from_tas_sq_pa(v_air ** 2, ps, oat)
-        static = {"ps_pa": static_port_pa(ps, qc, opts.model, opts.k), "oat_k": oat}
-    else:
-        qc = impact_pressure_pa(rho, v_air ** 2)
+    if isinstance(true_air, StaticAir):
+        static = {"ps_pa": static_port_pa(true_air.ps, qc, opts.model, opts.k),
+                  "oat_k": true_air.oat}
     air = {}
-    if opts.air_sensors is not None:      # issue 9 item 7: temperature, humidity, probe arm
+    if opts.air_sensors is not None:      # temperature, humidity, probe arm
         qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
                                    opts.k)
     climb = np.gradient(alt, dt) if n > 1 else np.zeros(n)
@@ -231,7 +227,7 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
     meta = {"generator": "pitotcal simulate", "seed": seed, "model": opts.model,
             **dict(zip(get_model(opts.model).params, opts.k)),
             "wind_speed_mps": opts.wind_speed_mps, "wind_from_deg": opts.wind_from_deg}
-    if opts.air_data != "incompressible":         # the default's CSV stays as it was
+    if opts.air_data != "incompressible":   # an incompressible flight's CSV keeps its bytes
         meta["air_data"] = opts.air_data
     flight = Flight(time_s=t, qci_pa=qci, gps_vn_mps=gps[:, 0], gps_ve_mps=gps[:, 1],
                     rho_kgm3=rho, gps_vd_mps=gps[:, 2], alt_m=alt,
@@ -314,7 +310,7 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
              wind_drift_mps2=(0.0, 0.0), turbulence_mps=0.5, turbulence_length_m=None,
              rate_hz=50.0, qc_noise_pa=0.5, qc_quantization_pa=0.0, qc_bias_pa=0.0,
              qc_scale_error=0.0, pneumatic_lag_s=0.0, gps_rate_hz=5.0, gps_noise_mps=0.05,
-             gps_latency_s=0.0, air_data="incompressible", limits=None, speed_loop=None,
+             gps_latency_s=0.0, air_data=DEFAULT_AIR_DATA, limits=None, speed_loop=None,
              keep_history=False, air_sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
              vertical_gusts=False):
     """Fly `plan` in simulation and record what the sensors would log.
@@ -349,9 +345,10 @@ def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind
         GPS velocity: update rate (Hz, sample-and-hold in between; 0 = every sample), white
         noise std per component and update (m/s), age of the reported velocity (s).
     air_data : {"incompressible", "compressible"}
-        True impact pressure: ½ρV_t² (the paper's eq. 2, the default) or isentropic with
-        the ISA p_s and T at the altitude flown (pitotcal.core.airdata); compressible flights
-        also carry `ps_pa` (the static port: p_s + q_c − q_ci) and `oat_k`.
+        True impact pressure (`pitotcal.core.measurement`): isentropic with the ISA p_s and
+        T at the altitude flown (the default, `DEFAULT_AIR_DATA`, as `identify` fits), or
+        ½ρV_t² (the paper's eq. 2); compressible flights also carry `ps_pa` (the static port:
+        p_s + q_c − q_ci) and `oat_k`.
     gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts : float, float, bool
         Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s);
         fly Dryden's vertical gust too (`_plunge`; False: as before).

@@ -9,8 +9,10 @@ after the summary; the JSON and figure are written first).
 
 from pathlib import Path
 
+from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
+
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
-AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_DATA_MODES
+AIR_CHOICES = AIR_DATA_MODES
 
 
 def add_parser(subparsers):
@@ -28,14 +30,13 @@ def add_parser(subparsers):
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
-    # --- air data (issue 9) ---
-    p.add_argument("--air", default="compressible", metavar="MODE",
+    p.add_argument("--air", default=DEFAULT_AIR_DATA, metavar="MODE",
                    help="how impact pressure follows from true airspeed: compressible "
                         "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
                         "all pressure error taken in the static source, or separated with "
                         "a ps_ref_pa reference column; V_i, V_c standard CAS) or "
                         "incompressible (q_c = rho V^2/2, V = sqrt(2q/rho0): the "
-                        "paper's eq. 2 and the results before issue 9); a flight without "
+                        "paper's eq. 2); a flight without "
                         "ps_pa/oat_k is fitted incompressible with a warning; default "
                         "%(default)s")
     p.add_argument("--json", metavar="OUT.json", default=None, help="write the result as JSON")

@@ -3,7 +3,7 @@
 
 def add_parser(subparsers):
     # numpy-free: the parser is built for every command (TRUE_K has one entry per model)
-    from pitotcal.core.scenario import TRUE_K, true_k
+    from pitotcal.core.scenario import DEFAULT_AIR_DATA, TRUE_K, true_k
 
     p = subparsers.add_parser(
         "simulate", help="fly a plan in simulation and write a flight CSV with its truth",
@@ -48,9 +48,10 @@ def add_parser(subparsers):
                         "airspeed includes the air-relative climb (own engine; JSBSim's "
                         "turbulence always has it)")
     g.add_argument("--air-data", default=None,
-                   help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
-                        "the paper's eq. 2; default) or compressible (isentropic, ISA p and T); "
-                        "JSBSim's is always compressible")
+                   help="true impact pressure from true airspeed: compressible (isentropic, "
+                        "ISA p and T; the flight gets ps_pa and oat_k) or incompressible "
+                        "(1/2 rho V^2, the paper's eq. 2); default %s, as identify fits; "
+                        "JSBSim's is always compressible" % DEFAULT_AIR_DATA)
     e = p.add_argument_group("flight model")
     e.add_argument("--engine", default="own", choices=("own", "jsbsim"),
                    help="own: pitotcal's point-mass model (fast, default); jsbsim: the JSBSim "
@@ -166,6 +167,7 @@ def _engine(args):
 def run(args):
     import warnings
 
+    from pitotcal.core.scenario import DEFAULT_AIR_DATA
     from pitotcal.io import write_flight_csv
     from pitotcal.io.plan_csv import read_plan
     from pitotcal.maneuvers.fly.truth import tracking_warnings, write_truth_json
@@ -186,7 +188,7 @@ def run(args):
         qc_quantization_pa=args.qc_quantization_pa, qc_bias_pa=args.qc_bias_pa,
         qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
         gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
-        gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
+        gps_latency_s=args.gps_latency_s, air_data=args.air_data or DEFAULT_AIR_DATA,
         keep_history=fault is not None, gps_gm_sigma_mps=args.gps_gm_sigma_mps,
         gps_gm_tau_s=args.gps_gm_tau_s, **_air_sensor_option(args),
         **({"vertical_gusts": True} if args.vertical_gusts else {}))

@@ -16,9 +16,9 @@ The air data say how the true impact pressure follows from the true airspeed:
 Each gives q_c(V_t²), dq_c/dV_t², d²q_c/d(V_t²)² and the inverse V_t²(q_c) with numpy or
 CasADi (`pitotcal.core.airdata` holds the standard relations). `predict_qci_pa` is the one
 predictor of q_ci from ground velocity, wind, the pressure-error model and the air data;
-`flight_air` the one constructor of a flight's air data; `AIR_DATA_MODES` and
-`DEFAULT_AIR_DATA` the one place of the mode names and the default (shared by `simulate` and
-`identify`).
+`flight_air` the one constructor of a flight's air data. The mode names `AIR_DATA_MODES` and
+the default `DEFAULT_AIR_DATA` (shared by `simulate` and `identify`) are defined in the
+numpy-free `pitotcal.core.scenario` and given out here.
 """
 
 from typing import NamedTuple
@@ -28,6 +28,7 @@ import numpy as np
 from . import airdata
 from .errors import FlightDataError
 from .models import qci_from_qc_pa
+from .scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from .units import (
     ISA_EXPONENT,
     ISA_P0_PA,
@@ -56,10 +57,6 @@ __all__ = [
     "tas_squared",
 ]
 
-# How impact pressure follows from true airspeed: the paper's eq. 2 (½ρV_t²) or isentropic.
-AIR_DATA_MODES = ("incompressible", "compressible")
-# The standard (isentropic) relation: what `simulate` flies and `identify` fits by default.
-DEFAULT_AIR_DATA = "compressible"
 # The flight's data channels of each air-data type (`flight_air`), by the estimator's mode:
 # "reference" is the compressible fit from an independent reference static pressure.
 AIR_CHANNELS = {"incompressible": ("rho",), "compressible": ("pt", "oat"),
