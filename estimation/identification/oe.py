@@ -198,7 +198,7 @@ class OutputErrorProblem:
         flight : pitotcal.core.flight.Flight
         gps_noise_std_mps : float, optional
             GPS velocity noise per component, m/s; estimated from the data when None
-            (`estimation.identification.eiv.estimate_gps_noise_std`).
+            (`pitotcal.core.gps_velocity.estimate_gps_noise_std`).
         start : ndarray, optional
             Start values (k..., wind_n_mps, wind_e_mps); the linear least-squares start
             (`start_values`) when None.

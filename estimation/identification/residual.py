@@ -21,23 +21,21 @@ sensitivities, the instrumental-variable steps) and build the problem's MX graph
 (`residual_function`).
 """
 
-from dataclasses import dataclass
-
-import numpy as np
-
 from pitotcal.core.measurement import (
     AIR_CHANNELS,
+    Channels,
     IncompressibleAir,
     StaticAir,
     TotalPressureAir,
     as_air,
-    flight_air,
+    flight_channels,
     is_compressible,
     qci_terms,
+    ratio_columns,
+    sensitivities,
     tas_squared,
 )
 
-from .eiv import estimate_gps_noise_std, interpolate_held
 from .unknowns import COEFS, WIND_E, WIND_N
 
 __all__ = [
@@ -49,74 +47,6 @@ __all__ = [
 # The estimator's names of the measurement model's compressible air-data types.
 TotalAir = TotalPressureAir
 ReferenceAir = StaticAir
-
-
-@dataclass(frozen=True)
-class Channels:
-    """A flight's data as the residual uses it, SI, arrays of shape (N,).
-
-    GPS velocity is interpolated where the log held it (`estimation.identification.eiv.interpolate_held`);
-    `var_v` is the GPS noise variance per component after that interpolation. `oat` (static
-    temperature, K) and either `pt` (total pressure p_s,ind + q_ci, Pa) or `ps_ref` (a
-    reference static pressure, Pa) are set for the compressible problem only.
-    """
-
-    qci: np.ndarray
-    vn: np.ndarray
-    ve: np.ndarray
-    rho: np.ndarray
-    vd2: np.ndarray | None   # GPS vertical speed squared, m^2/s^2 (None: no vertical channel)
-    sigma_v: float       # GPS velocity noise per component, m/s
-    var_v: float         # m^2/s^2
-    n_comp: int          # velocity components: 2, or 3 with a vertical speed
-    pt: np.ndarray | None = None
-    oat: np.ndarray | None = None
-    ps_ref: np.ndarray | None = None
-
-    @property
-    def c_eiv(self):
-        """n sigma_v^2 (after interpolation): the mean GPS noise adds to V_t^2, m^2/s^2."""
-        return self.n_comp * self.var_v
-
-    @property
-    def air(self):
-        """The air data of the prediction (`pitotcal.core.measurement`): `IncompressibleAir`,
-        `TotalPressureAir` or `StaticAir`."""
-        if self.ps_ref is not None:
-            return StaticAir(self.ps_ref, self.oat)
-        return IncompressibleAir(self.rho) if self.pt is None else TotalPressureAir(self.pt,
-                                                                                    self.oat)
-
-    @property
-    def args(self):
-        """(qci, vn, ve, air, vd2, c_eiv): the data arguments of `residual_terms`."""
-        return self.qci, self.vn, self.ve, self.air, self.vd2, self.c_eiv
-
-
-def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible"):
-    """The `Channels` of `flight`; sigma_v estimated from the data when not given.
-
-    The air data come from `pitotcal.core.measurement.flight_air`: "compressible" needs the
-    flight's `ps_pa` and `oat_k`, "reference" its `ps_ref_pa` and `oat_k`
-    (`estimation.identify` checks and chooses).
-    """
-    gps = (flight.gps_vn_mps, flight.gps_ve_mps)
-    if flight.gps_vd_mps is not None:
-        gps += (flight.gps_vd_mps,)
-    if gps_noise_std_mps is None:
-        sigma_v = estimate_gps_noise_std(flight.time_s, *gps)
-    else:
-        sigma_v = float(gps_noise_std_mps)
-    vel, noise_factor = interpolate_held(flight.time_s, *gps)
-    air = flight_air(flight, air_data)
-    extra = {}
-    if isinstance(air, TotalPressureAir):
-        extra = {"pt": air.pt, "oat": air.oat}
-    elif isinstance(air, StaticAir):
-        extra = {"ps_ref": air.ps, "oat": air.oat}
-    return Channels(qci=flight.qci_pa, vn=vel[0], ve=vel[1], rho=flight.rho_kgm3,
-                    vd2=vel[2] ** 2 if len(vel) == 3 else None, sigma_v=float(sigma_v),
-                    var_v=noise_factor * sigma_v ** 2, n_comp=len(vel), **extra)
 
 
 def impact_pressure(air, tas_sq):
@@ -193,32 +123,6 @@ def spread_weights(model, theta, ch):
     a = gain * d1
     spread = 4.0 * ch.var_v * tas_sq - 2.0 * ch.n_comp * ch.var_v ** 2
     return 1.0, 4.0 * ch.var_v * a ** 2 + 2.0 * a * gain * d2 * spread
-
-
-def ratio_columns(model, k, qci):
-    """d f(q_ci; k) / d k_i for each coefficient, by central differences (exact when f is
-    linear in k, as every registered structure is)."""
-    cols = []
-    for i, h in enumerate(model.scales):
-        up, dn = k.copy(), k.copy()
-        up[i] += h
-        dn[i] -= h
-        cols.append((model(up, qci) - model(dn, qci)) / (2 * h))
-    return cols
-
-
-def sensitivities(model, theta, qci, vn, ve, air, vd2=None, c_eiv=0.0):
-    """Output sensitivities S = dr/dtheta at theta, numpy, shape (N, p).
-
-    Closed form for the wind, dr/dwind_n = 2 a (V_gn - wind_n) with the local slope a; the
-    coefficients as the predicted q_c times the model's ratio columns (`ratio_columns`).
-    """
-    k = theta[COEFS]
-    tas_sq = tas_squared(vn, ve, theta[WIND_N], theta[WIND_E], vd2) - c_eiv
-    _, a, qc = qci_terms(model, k, qci, tas_sq, air)
-    cols = [qc * col for col in ratio_columns(model, k, qci)]
-    cols += [2.0 * a * (vn - theta[WIND_N]), 2.0 * a * (ve - theta[WIND_E])]
-    return np.column_stack(cols)
 
 
 def residual_function(model, n, has_vd, air_data="incompressible"):

@@ -16,17 +16,20 @@ The air data say how the true impact pressure follows from the true airspeed:
 Each gives q_c(V_t²), dq_c/dV_t², d²q_c/d(V_t²)² and the inverse V_t²(q_c) with numpy or
 CasADi (`pitotcal.core.airdata` holds the standard relations). `predict_qci_pa` is the one
 predictor of q_ci from ground velocity, wind, the pressure-error model and the air data;
-`flight_air` the one constructor of a flight's air data. The mode names `AIR_DATA_MODES` and
+`flight_air` the one constructor of a flight's air data, `flight_channels` a flight's data as
+the output-error residual uses it and `sensitivities` that residual's derivatives. The mode names `AIR_DATA_MODES` and
 the default `DEFAULT_AIR_DATA` (shared by `simulate` and `identify`) are defined in the
 numpy-free `pitotcal.core.scenario` and given out here.
 """
 
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
 from . import airdata
 from .errors import FlightDataError
+from .gps_velocity import estimate_gps_noise_std, interpolate_held
 from .models import qci_from_qc_pa
 from .scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from .units import (
@@ -42,18 +45,22 @@ from .units import (
 __all__ = [
     "AIR_CHANNELS",
     "AIR_DATA_MODES",
+    "Channels",
     "DEFAULT_AIR_DATA",
     "IncompressibleAir",
     "StaticAir",
     "TotalPressureAir",
     "as_air",
     "flight_air",
+    "flight_channels",
     "impact_pressure_pa",
     "is_compressible",
     "isa_air",
     "isa_air_of_density",
     "predict_qci_pa",
     "qci_terms",
+    "ratio_columns",
+    "sensitivities",
     "tas_squared",
 ]
 
@@ -252,3 +259,99 @@ def isa_air_of_density(rho_kgm3, air_data=DEFAULT_AIR_DATA):
     rho0 = ISA_P0_PA / (R_AIR_JKGK * ISA_T0_K)
     oat = ISA_T0_K * (rho / rho0) ** (1.0 / (ISA_EXPONENT - 1.0))
     return StaticAir(rho * R_AIR_JKGK * oat, oat)
+
+
+@dataclass(frozen=True)
+class Channels:
+    """A flight's data as the output-error residual uses it, SI, arrays of shape (N,).
+
+    GPS velocity is interpolated where the log held it (`core.gps_velocity.interpolate_held`);
+    `var_v` is the GPS noise variance per component after that interpolation. `oat` (static
+    temperature, K) and either `pt` (total pressure p_s,ind + q_ci, Pa) or `ps_ref` (a
+    reference static pressure, Pa) are set for the compressible problem only.
+    """
+
+    qci: np.ndarray
+    vn: np.ndarray
+    ve: np.ndarray
+    rho: np.ndarray
+    vd2: np.ndarray | None   # GPS vertical speed squared, m^2/s^2 (None: no vertical channel)
+    sigma_v: float       # GPS velocity noise per component, m/s
+    var_v: float         # m^2/s^2
+    n_comp: int          # velocity components: 2, or 3 with a vertical speed
+    pt: np.ndarray | None = None
+    oat: np.ndarray | None = None
+    ps_ref: np.ndarray | None = None
+
+    @property
+    def c_eiv(self):
+        """n sigma_v^2 (after interpolation): the mean GPS noise adds to V_t^2, m^2/s^2."""
+        return self.n_comp * self.var_v
+
+    @property
+    def air(self):
+        """The air data of the prediction: `IncompressibleAir`, `TotalPressureAir` or
+        `StaticAir`."""
+        if self.ps_ref is not None:
+            return StaticAir(self.ps_ref, self.oat)
+        return IncompressibleAir(self.rho) if self.pt is None else TotalPressureAir(self.pt,
+                                                                                    self.oat)
+
+    @property
+    def args(self):
+        """(qci, vn, ve, air, vd2, c_eiv): the data arguments of the residual."""
+        return self.qci, self.vn, self.ve, self.air, self.vd2, self.c_eiv
+
+
+def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible"):
+    """The `Channels` of `flight`; sigma_v estimated from the data when not given.
+
+    The air data come from `flight_air`: "compressible" needs the flight's `ps_pa` and
+    `oat_k`, "reference" its `ps_ref_pa` and `oat_k` (`estimation.identify` checks and
+    chooses).
+    """
+    gps = (flight.gps_vn_mps, flight.gps_ve_mps)
+    if flight.gps_vd_mps is not None:
+        gps += (flight.gps_vd_mps,)
+    if gps_noise_std_mps is None:
+        sigma_v = estimate_gps_noise_std(flight.time_s, *gps)
+    else:
+        sigma_v = float(gps_noise_std_mps)
+    vel, noise_factor = interpolate_held(flight.time_s, *gps)
+    air = flight_air(flight, air_data)
+    extra = {}
+    if isinstance(air, TotalPressureAir):
+        extra = {"pt": air.pt, "oat": air.oat}
+    elif isinstance(air, StaticAir):
+        extra = {"ps_ref": air.ps, "oat": air.oat}
+    return Channels(qci=flight.qci_pa, vn=vel[0], ve=vel[1], rho=flight.rho_kgm3,
+                    vd2=vel[2] ** 2 if len(vel) == 3 else None, sigma_v=float(sigma_v),
+                    var_v=noise_factor * sigma_v ** 2, n_comp=len(vel), **extra)
+
+
+def ratio_columns(model, k, qci):
+    """d f(q_ci; k) / d k_i for each coefficient, by central differences (exact when f is
+    linear in k, as every registered structure is)."""
+    cols = []
+    for i, h in enumerate(model.scales):
+        up, dn = k.copy(), k.copy()
+        up[i] += h
+        dn[i] -= h
+        cols.append((model(up, qci) - model(dn, qci)) / (2 * h))
+    return cols
+
+
+def sensitivities(model, theta, qci, vn, ve, air, vd2=None, c_eiv=0.0):
+    """Output sensitivities S = dr/dtheta of the residual r = q_ci − predicted at theta =
+    (k..., wind_n, wind_e), numpy, shape (N, p + 2).
+
+    Closed form for the wind, dr/dwind_n = 2 a (V_gn - wind_n) with the local slope
+    a = dq_ci/dV_t² (`qci_terms`); the coefficients as the predicted q_c times the model's
+    ratio columns (`ratio_columns`).
+    """
+    k, wind_n, wind_e = theta[:-2], theta[-2], theta[-1]
+    tas_sq = tas_squared(vn, ve, wind_n, wind_e, vd2) - c_eiv
+    _, a, qc = qci_terms(model, k, qci, tas_sq, air)
+    cols = [qc * col for col in ratio_columns(model, k, qci)]
+    cols += [2.0 * a * (vn - wind_n), 2.0 * a * (ve - wind_e)]
+    return np.column_stack(cols)
