@@ -12,7 +12,8 @@ from pathlib import Path
 from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
 
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
-AIR_CHOICES = AIR_DATA_MODES
+# the default first, as --help and the error list them
+AIR_CHOICES = (DEFAULT_AIR_DATA, *(m for m in AIR_DATA_MODES if m != DEFAULT_AIR_DATA))
 
 
 def add_parser(subparsers):
