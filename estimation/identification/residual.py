@@ -29,7 +29,6 @@ from pitotcal.core.measurement import (
     TotalPressureAir,
     as_air,
     flight_channels,
-    is_compressible,
     qci_terms,
     ratio_columns,
     sensitivities,
@@ -39,7 +38,7 @@ from pitotcal.core.measurement import (
 from .unknowns import COEFS, WIND_E, WIND_N
 
 __all__ = [
-    "AIR_CHANNELS", "Channels", "ReferenceAir", "TotalAir", "flight_channels", "impact_pressure", "is_compressible",
+    "AIR_CHANNELS", "Channels", "ReferenceAir", "TotalAir", "flight_channels",
     "ratio_columns", "residual", "residual_function", "residual_terms", "sensitivities",
     "slope", "spread_weights",
 ]
@@ -47,12 +46,6 @@ __all__ = [
 # The estimator's names of the measurement model's compressible air-data types.
 TotalAir = TotalPressureAir
 ReferenceAir = StaticAir
-
-
-def impact_pressure(air, tas_sq):
-    """(q_c, dq_c/dV_t^2) of the air data `air` at V_t^2 = `tas_sq`."""
-    air = as_air(air)
-    return air.qc_pa(tas_sq), air.derivatives(tas_sq)[0]
 
 
 def slope(model, k, qci, air, tas_sq=None, c_eiv=0.0):

@@ -54,7 +54,6 @@ __all__ = [
     "flight_air",
     "flight_channels",
     "impact_pressure_pa",
-    "is_compressible",
     "isa_air",
     "isa_air_of_density",
     "predict_qci_pa",
@@ -162,11 +161,6 @@ def as_air(air):
     if isinstance(air, tuple):
         return TotalPressureAir(*air)
     return IncompressibleAir(air)
-
-
-def is_compressible(air):
-    """Whether `air` (any form `as_air` takes) is isentropic air data, not a density."""
-    return not isinstance(as_air(air), IncompressibleAir)
 
 
 def qci_terms(model, k, qci_pa, tas_sq, air):
