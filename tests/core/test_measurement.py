@@ -1,10 +1,29 @@
-"""pitotcal.core.measurement: the same numbers on numpy arrays and on CasADi MX."""
+"""pitotcal.core.measurement: the same numbers on numpy arrays and on CasADi MX; the air-data
+types against an independent library; every user of the measurement model predicting the same
+q_ci for the same state."""
+
+import warnings
 
 import casadi as ca
 import numpy as np
 import pytest
 
-from pitotcal.core.measurement import impact_pressure_pa, tas_squared
+from pitotcal.core import airdata as ad
+from pitotcal.core import units
+from pitotcal.core.measurement import (
+    AIR_DATA_MODES,
+    DEFAULT_AIR_DATA,
+    IncompressibleAir,
+    StaticAir,
+    TotalPressureAir,
+    flight_air,
+    impact_pressure_pa,
+    isa_air,
+    isa_air_of_density,
+    predict_qci_pa,
+    tas_squared,
+)
+from pitotcal.core.models import get_model
 
 
 def test_hand_values():
@@ -31,28 +50,6 @@ def test_numpy_and_casadi_agree(has_vd):
     got_v2, got_qc = fn(vn, ve, [wind_n, wind_e], rho, vd_sq if has_vd else np.zeros(n))
     np.testing.assert_allclose(np.asarray(got_v2).ravel(), want_v2, rtol=1e-15)
     np.testing.assert_allclose(np.asarray(got_qc).ravel(), want_qc, rtol=1e-15)
-
-
-# ---------------------------------------------------------------------------------------------
-# The air-data types, the one predictor and its users
-
-
-import warnings  # noqa: E402
-
-from pitotcal.core import airdata as ad  # noqa: E402
-from pitotcal.core import units  # noqa: E402
-from pitotcal.core.measurement import (  # noqa: E402
-    AIR_DATA_MODES,
-    DEFAULT_AIR_DATA,
-    IncompressibleAir,
-    StaticAir,
-    TotalPressureAir,
-    flight_air,
-    isa_air,
-    isa_air_of_density,
-    predict_qci_pa,
-)
-from pitotcal.core.models import get_model  # noqa: E402
 
 
 def _airs():

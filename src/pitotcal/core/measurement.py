@@ -16,10 +16,19 @@ The air data say how the true impact pressure follows from the true airspeed:
 Each gives q_c(V_t²), dq_c/dV_t², d²q_c/d(V_t²)² and the inverse V_t²(q_c) with numpy or
 CasADi (`pitotcal.core.airdata` holds the standard relations). `predict_qci_pa` is the one
 predictor of q_ci from ground velocity, wind, the pressure-error model and the air data;
-`flight_air` the one constructor of a flight's air data, `flight_channels` a flight's data as
-the output-error residual uses it and `sensitivities` that residual's derivatives. The mode names `AIR_DATA_MODES` and
-the default `DEFAULT_AIR_DATA` (shared by `simulate` and `identify`) are defined in the
-numpy-free `pitotcal.core.scenario` and given out here.
+`flight_air` the one constructor of a flight's air data; `flight_channels` a flight's data as
+the output-error residual uses it and `sensitivities` that residual's derivatives. The mode
+names `AIR_DATA_MODES` and the default `DEFAULT_AIR_DATA` (shared by `simulate` and
+`identify`) are defined in the numpy-free `pitotcal.core.scenario` (the command line's parser
+quotes them) and given out here.
+
+Example
+-------
+>>> air = StaticAir(101325.0, 288.15)                  # sea level, ISA
+>>> round(float(air.qc_pa(102.8889 ** 2)), 1)          # 200 kt true airspeed
+6633.5
+>>> round(float(air.tas_sq(6633.5)) ** 0.5, 3)
+102.889
 """
 
 from dataclasses import dataclass
@@ -242,7 +251,7 @@ def isa_air(alt_m, air_data=DEFAULT_AIR_DATA, oat_k=None):
 
 def isa_air_of_density(rho_kgm3, air_data=DEFAULT_AIR_DATA):
     """The ISA air of density ρ (kg/m³): `IncompressibleAir` (ρ) or `StaticAir` at the ISA
-    troposphere state of that density, T = T₀ (ρ/ρ₀)^(1/(n − 1)), p = ρ R T (n = g₀/(R L)).
+    troposphere state of that density, T = T₀ (ρ/ρ₀)^(1/(n − 1)), p = ρ R T, n = g₀/(R L).
 
     For callers that carry only a density (the design's schedules): the compressible relation
     then needs the pressure and temperature that go with it.
