@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pitotcal.core.errors import PitotcalError
+from pitotcal.core.measurement import DEFAULT_AIR_DATA
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
 from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S, read_stream
 
@@ -89,7 +90,7 @@ class LiveIdentifier:
         slow velocity error), counted in every update's bounds.
     """
 
-    def __init__(self, model="inverse", air="compressible", gps_error=None):
+    def __init__(self, model="inverse", air=DEFAULT_AIR_DATA, gps_error=None):
         from .identification.oe import OutputErrorProblem
 
         self.model, self.air = model, air
@@ -126,7 +127,7 @@ class LiveIdentifier:
 
 
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
-                    idle_timeout_s=IDLE_TIMEOUT_S, on_fix=None, max_s=None, air="compressible",
+                    idle_timeout_s=IDLE_TIMEOUT_S, on_fix=None, max_s=None, air=DEFAULT_AIR_DATA,
                     gps_error=None):
     """Re-identify the growing maneuver every second (warm-started, `LiveIdentifier`); returns
     (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`

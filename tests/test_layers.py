@@ -133,3 +133,18 @@ def test_a_command_never_imports_another_command(graph):
     commands = {n for n in graph if n.startswith("pitotcal.cli.") and n not in shared}
     assert "pitotcal.cli.common" in graph["pitotcal.cli.identify"]
     assert {n: sorted(graph[n] & commands) for n in commands if graph[n] & commands} == {}
+
+
+def test_estimation_subpackages_import_one_way(graph):
+    """uncertainty -> robustness -> identification: a lower one never imports a higher one
+    (the flight's channels and the residual's sensitivities come from core.measurement)."""
+    order = ("uncertainty", "robustness", "identification")
+    prefix = "pitotcal.estimation."
+    wrong = []
+    for name, targets in graph.items():
+        if not name.startswith(prefix) or name.split(".")[2] not in order:
+            continue
+        rank = order.index(name.split(".")[2])
+        wrong += [(name, t) for t in targets if t.startswith(prefix) and len(t.split(".")) > 2
+                  and t.split(".")[2] in order[rank + 1:]]
+    assert wrong == []

@@ -92,7 +92,7 @@ def _constants():
         ("plan", f"limits the bank (default: {d.stall_margin:g})"),
         ("plan", f"(default: {d.check_fraction:g}; 0: two speeds only)"),
         ("demo", f"the demo's {DEMO_SIM['rate_hz']:g})"),
-        ("simulate", f"default {ENGINE_AIR_DATA['own']};"),
+        ("simulate", f"default {ENGINE_AIR_DATA['own']}, as identify"),
         ("simulate", f"(default {DEFAULT_AIRCRAFT})"),
         ("study", f"${ALFA_DATA_ENV}, else ./{ALFA_DIR_NAME}"),
         ("study", f"JSBSim's {DEFAULT_AIRCRAFT};"),

@@ -7,7 +7,7 @@ import logging
 import numpy as np
 
 from pitotcal.core import checks
-from pitotcal.core.airdata import AIR_DATA_MODES
+from pitotcal.core.measurement import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from pitotcal.core.errors import FlightDataError, ObservabilityError, PitotcalError
 from pitotcal.core.models import MODELS, get_model
 from pitotcal.core.scenario import GPS_NOISE_MAX_MPS
@@ -34,7 +34,7 @@ _PROBLEMS = {}
 _TRIM_ROUNDS = 3
 
 
-def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
+def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
     """Identify the pressure-error model and the wind from one calibration flight.
 
@@ -46,10 +46,11 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         Pressure-error structure (docs/interfaces.md §2); "auto" fits every structure in
         `pitotcal.core.models.MODELS` and keeps the one with the lowest BIC.
     air : {"compressible", "incompressible"}
-        How the impact pressure follows from the true airspeed (`estimation.identification.residual`):
+        How the impact pressure follows from the true airspeed (`pitotcal.core.measurement`):
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
-        temperature `oat_k`, with all the pressure error in the static source (the default),
-        or the paper's eq. 2, q_c = ½ρV_t² ("incompressible", no static port needed). A
+        temperature `oat_k`, with all the pressure error in the static source (the default,
+        `DEFAULT_AIR_DATA`, which `simulate` flies), or the paper's eq. 2, q_c = ½ρV_t²
+        ("incompressible"). A
         flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
         an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
         it instead, and the static and total pressure errors are separated
@@ -98,7 +99,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
                      (gps_error_sigma_mps, gps_error_tau_s), bounds=True)
 
 
-def estimate(flight, model="inverse", *, air="compressible", gps_noise_std_mps=None,
+def estimate(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
     """`identify`'s estimate alone, for re-solves that use only it (`estimation.identification.budget`).
 

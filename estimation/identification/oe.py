@@ -17,20 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from pitotcal.core import checks
-from pitotcal.core.airdata import GAMMA, mach_from_qc
-from pitotcal.core.measurement import impact_pressure_pa, tas_squared
+from pitotcal.core.measurement import AIR_CHANNELS, IncompressibleAir, as_air, tas_squared
 from pitotcal.core.models import get_model
 from pitotcal.core.processes import solver_interrupts
-from pitotcal.core.units import R_AIR_JKGK
 
 from ..uncertainty.covariance import ColoredCovariance, colored_covariance, plain_covariance
 from .iv import IV_WINDOW_S, iv_refine, smooth_in_time
 from .residual import (
-    AIR_CHANNELS,
-    ReferenceAir,
     flight_channels,
-    impact_pressure,
-    is_compressible,
     ratio_columns,
     residual,
     residual_function,
@@ -204,7 +198,7 @@ class OutputErrorProblem:
         flight : pitotcal.core.flight.Flight
         gps_noise_std_mps : float, optional
             GPS velocity noise per component, m/s; estimated from the data when None
-            (`estimation.identification.eiv.estimate_gps_noise_std`).
+            (`pitotcal.core.gps_velocity.estimate_gps_noise_std`).
         start : ndarray, optional
             Start values (k..., wind_n_mps, wind_e_mps); the linear least-squares start
             (`start_values`) when None.
@@ -352,10 +346,8 @@ def start_values(model, qci_pa, vn_mps, ve_mps, air, vd2=None, c_eiv=0.0):
     (about (1 - k1) V_t^2 too). The remaining coefficients then come from a Gauss-Newton
     fit of the per-sample ratio 1 - q_ci / q_c(W) to the model.
     """
-    if is_compressible(air):
-        y = _tas_sq_of_qc(qci_pa, air)                     # about (1 - f) V_t^2
-    else:
-        y = qci_pa / impact_pressure_pa(air, 1.0)          # (1 - f) V_t^2
+    air = as_air(air)
+    y = air.tas_sq(qci_pa)                                 # about (1 - f) V_t^2
     v2g = tas_squared(vn_mps, ve_mps, 0.0, 0.0, vd2) - c_eiv  # |V_g|^2 - c_eiv
     design = np.column_stack([v2g, -2.0 * vn_mps, -2.0 * ve_mps, np.ones_like(y)])
     colscale = np.sqrt(np.mean(design ** 2, axis=0))
@@ -366,10 +358,7 @@ def start_values(model, qci_pa, vn_mps, ve_mps, air, vd2=None, c_eiv=0.0):
     k[0] = 1.0 - c
     # Gauss-Newton on the ratio (exact in one step for models linear in k)
     tas_sq = tas_squared(vn_mps, ve_mps, wn, we, vd2) - c_eiv
-    if is_compressible(air):
-        qc = impact_pressure(air, np.maximum(tas_sq, 0.0))[0]
-    else:
-        qc = impact_pressure_pa(air, tas_sq)
+    qc = air.qc_pa(tas_sq if isinstance(air, IncompressibleAir) else np.maximum(tas_sq, 0.0))
     ok = qc > 0
     ratio = 1.0 - qci_pa[ok] / qc[ok]
     q = qci_pa[ok]
@@ -378,13 +367,6 @@ def start_values(model, qci_pa, vn_mps, ve_mps, air, vd2=None, c_eiv=0.0):
                                rcond=None)[0]
         k = k + step
     return np.concatenate([k, [wn, we]])
-
-
-def _tas_sq_of_qc(qc_pa, air):
-    """V_t^2 whose impact pressure is q_c with the compressible air data `air`."""
-    ps = air.ps if isinstance(air, ReferenceAir) else air.pt - qc_pa
-    mach = mach_from_qc(qc_pa, ps)
-    return mach * np.abs(mach) * GAMMA * R_AIR_JKGK * air.oat
 
 
 def _gap_warning(time_s):

@@ -27,7 +27,8 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.errors import ObservabilityError, PitotcalError
-from pitotcal.core.models import delta_v_kt, get_model
+from pitotcal.core.measurement import TotalPressureAir
+from pitotcal.core.models import delta_v_kt, get_model, qc_from_qci_pa
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import KT_TO_MPS, m_to_ft, wind_polar
 
@@ -66,10 +67,14 @@ def wind_groups(legs, mode, band_ft=BAND_FT):
 
 
 def predicted_tas_mps(model, k, qci_pa, ps_ind_pa, oat_k):
-    """True airspeed a leg flies at by the model (module docstring)."""
-    qc = qci_pa / (1.0 - model(k, qci_pa))
-    ps = ps_ind_pa - (qc - qci_pa)
-    return airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)
+    """True airspeed a leg flies at by the model (module docstring): the measurement model
+    inverted, V_t² of q_c = q_ci / (1 − f(q_ci; k)) at the total pressure p_s,ind + q_ci
+    (`pitotcal.core.measurement.TotalPressureAir`)."""
+    qci_pa = np.asarray(qci_pa, dtype=float)
+    air = TotalPressureAir(np.asarray(ps_ind_pa, dtype=float) + qci_pa,
+                           np.asarray(oat_k, dtype=float))
+    tas_sq = air.tas_sq(qc_from_qci_pa(model, k, qci_pa))
+    return np.sign(tas_sq) * np.sqrt(np.abs(tas_sq))      # signed, as the Mach of a negative q_c
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,7 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.errors import ObservabilityError
+from pitotcal.core.measurement import TotalPressureAir
 from pitotcal.core.units import KT_TO_MPS, wind_polar
 
 __all__ = ["DOP_MAX", "PointSolution", "cas_from_tas_mps", "circle_jacobian", "solve_point",
@@ -209,18 +210,18 @@ def _subset_solutions(legs, idx, g):
     return np.array(sols), np.mean(jacs, axis=0), refused, float(np.mean(dops))
 
 
-def cas_from_tas_mps(tas_mps, qci_pa, ps_ind_pa, oat_k, iterations=6):
+def cas_from_tas_mps(tas_mps, qci_pa, ps_ind_pa, oat_k):
     """(V_c m/s, q_c Pa) of a true airspeed, the static-source error corrected.
 
     q_c = q_c(V_t, p_s, T_s) isentropic, with p_s = p_s,ind − (q_c − q_ci): the static port
-    reads p_s,ind, and with all the position error in the static source Δp_p = q_c − q_ci. The
-    fixed point contracts by ~q_c/p_s per step.
+    reads p_s,ind, and with all the position error in the static source Δp_p = q_c − q_ci, so
+    the total pressure p_s,ind + q_ci is exact and q_c follows from it in closed form
+    (`pitotcal.core.measurement.TotalPressureAir`).
     """
-    ps = np.asarray(ps_ind_pa, dtype=float)
-    for _ in range(iterations):
-        qc = airdata.qc_from_tas_pa(tas_mps, ps, oat_k)
-        ps = ps_ind_pa - (qc - qci_pa)
-    qc = airdata.qc_from_tas_pa(tas_mps, ps, oat_k)
+    qci_pa = np.asarray(qci_pa, dtype=float)
+    air = TotalPressureAir(np.asarray(ps_ind_pa, dtype=float) + qci_pa,
+                           np.asarray(oat_k, dtype=float))
+    qc = air.qc_pa(np.asarray(tas_mps, dtype=float) ** 2)
     return airdata.cas_from_qc_mps(qc), qc
 
 

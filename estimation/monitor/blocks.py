@@ -144,7 +144,7 @@ def _block_inputs(flight, blocks, air, offset):
 
     vd_sq = None if flight.gps_vd_mps is None else mean(flight.gps_vd_mps ** 2)
     return (mean(flight.gps_vn_mps), mean(flight.gps_ve_mps), vd_sq, mean(flight.rho_kgm3),
-            None if air is None else (mean(air[0]), mean(air[1])))
+            None if air is None else type(air)(*map(mean, air)))
 
 
 def _predict_block(cal, inputs, j, wind):
@@ -156,6 +156,6 @@ def _predict_block(cal, inputs, j, wind):
         return None if x is None else np.full(3, x[j])
 
     q = predict_qci_pa(cal, vn[j], ve[j], pick(vd_sq), rho[j],
-                       None if air is None else (air[0][j], air[1][j]),
+                       None if air is None else type(air)(*(c[j] for c in air)),
                        wind_ne=(winds[:, 0], winds[:, 1]))
     return float(q[0]), np.array([q[1] - q[0], q[2] - q[0]]) / _DW

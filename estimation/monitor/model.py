@@ -1,10 +1,10 @@
 """What the airspeed monitor knows of a calibration: the model, the wind, the air data and the
 statistics of its residuals, and the ONE prediction of q_ci from GPS velocity (paper section VI.B).
 
-The prediction inverts the calibration: V_t² from GPS and the wind (`core.measurement`), the
-true impact pressure from it — ½ρV_t² (`core.measurement`, incompressible) or isentropic from
-V_t², p_s and T_s (`core.airdata`, compressible) as the calibration's ``"air_data"`` says (absent:
-incompressible) — then what the pitot reads through the identified pressure error.
+The prediction is the measurement model's (`core.measurement.predict_qci_pa`): V_t² from GPS
+and the wind, the true impact pressure from it with the air data the calibration's
+``"air_data"`` names (absent: incompressible), then what the pitot reads through the identified
+pressure error.
 
 The block residual statistics (`block_residual_stats`) describe the calibration's output
 residuals on the monitor's block grid (BLOCK_S): the relative residual
@@ -23,7 +23,9 @@ import numpy as np
 
 from pitotcal.core.checks import choice
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.models import get_model, qci_from_qc_pa
+from pitotcal.core.measurement import IncompressibleAir, StaticAir, flight_air
+from pitotcal.core.measurement import predict_qci_pa as predict_measured_qci_pa
+from pitotcal.core.models import get_model
 from pitotcal.core.units import (
     R_AIR_JKGK,
     RHO0_KGM3,
@@ -84,9 +86,11 @@ class Calibration:
         return cls(model.name, k, float(wn), float(we), air, dict(noise), source)
 
     @classmethod
-    def from_result(cls, result, air_data="incompressible"):
-        """From an `IdentificationResult` in memory (its noise model computed here)."""
+    def from_result(cls, result, air_data=None):
+        """From an `IdentificationResult` in memory (its noise model computed here); the air
+        data the result was fitted with unless `air_data` is given."""
         wn, we = result.internal_params[-2:]
+        air_data = getattr(result, "air_data", "incompressible") if air_data is None else air_data
         return cls(result.model, tuple(map(float, result.coefficients)), float(wn), float(we),
                    air_data, block_residual_stats(result))
 
@@ -104,15 +108,15 @@ def _fallback_noise(d):
 
 
 def air_inputs(flight):
-    """(p_s, T_s) arrays for the compressible relation: the flight's own static pressure and
-    temperature when it has them, else ISA pressure at its altitude and T = p/(R ρ); None when
-    neither is there."""
-    ps, oat = getattr(flight, "ps_pa", None), getattr(flight, "oat_k", None)
-    if ps is not None and oat is not None:
-        return np.asarray(ps, float), np.asarray(oat, float)
+    """The air data of a compressible calibration's prediction for `flight`: the estimator's
+    (`pitotcal.core.measurement.flight_air`: total pressure p_s,ind + q_ci and T_s) when it has
+    its static pressure and temperature, else `StaticAir` at the ISA pressure of its altitude
+    and T = p/(R ρ); None when neither is there."""
+    if getattr(flight, "ps_pa", None) is not None and getattr(flight, "oat_k", None) is not None:
+        return flight_air(flight, "compressible")
     if flight.alt_m is not None and np.all(np.isfinite(flight.alt_m)):
         ps = isa_pressure_pa(flight.alt_m)
-        return ps, ps / (R_AIR_JKGK * flight.rho_kgm3)
+        return StaticAir(ps, ps / (R_AIR_JKGK * flight.rho_kgm3))
     return None
 
 
@@ -128,26 +132,21 @@ def predict_qci_pa(cal, vn, ve, vd_sq, rho, air=None, wind_ne=None):
         GPS vertical velocity squared, m²/s² (None: not measured).
     rho : array_like
         Air density, kg/m³.
-    air : (ps_pa, oat_k) or None
-        Static pressure and temperature (`air_inputs`); needed by a compressible calibration
-        (without it the incompressible relation is used).
+    air : air data of `pitotcal.core.measurement`, optional
+        What `air_inputs` gives; needed by a compressible calibration (without it the
+        incompressible relation is used).
     wind_ne : (float, float), optional
         Air-mass velocity north/east (the way it blows TO), m/s; default the calibration's.
 
     Notes
     -----
-    q_ci = q_c (1 − f(q_ci; k)), q_c = ½ρV_t² or p_s[(1 + 0.2 V_t²/(γRT_s))^3.5 − 1].
+    `pitotcal.core.measurement.predict_qci_pa`: q_ci = q_c (1 − f(q_ci; k)), the fixed point.
     """
-    from pitotcal.core.measurement import impact_pressure_pa, tas_squared
-
     wn, we = (cal.wind_n_mps, cal.wind_e_mps) if wind_ne is None else wind_ne
-    v2 = tas_squared(np.asarray(vn, float), np.asarray(ve, float), wn, we, vd_sq)
-    if cal.air_data == "compressible" and air is not None:
-        from pitotcal.core.airdata import qc_from_tas_sq_pa
-        qc = qc_from_tas_sq_pa(v2, air[0], air[1])
-    else:
-        qc = impact_pressure_pa(np.asarray(rho, float), v2)
-    return qci_from_qc_pa(get_model(cal.model), cal.k, qc)
+    if cal.air_data != "compressible" or air is None:
+        air = IncompressibleAir(np.asarray(rho, float))
+    return predict_measured_qci_pa(get_model(cal.model), cal.k, np.asarray(vn, float),
+                                   np.asarray(ve, float), wn, we, air, vd_sq)
 
 
 @dataclass(frozen=True)

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from pitotcal.core.errors import ObservabilityError, PitotcalError
+from pitotcal.core.measurement import DEFAULT_AIR_DATA
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import RHO0_KGM3
 from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
@@ -98,7 +99,7 @@ class ParameterRecommendation:
         return lines + list(self.notes)
 
 
-def recommend(flight, autopilot, current=None, *, name=None, air="compressible",
+def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DATA,
               **noise):
     """The airspeed parameter for `autopilot` from `flight`, or a refusal.
 
@@ -165,12 +166,10 @@ def recommend(flight, autopilot, current=None, *, name=None, air="compressible",
 
 def _parameter(autopilot, k1, qci_pa, air_data):
     """ARSPD_RATIO = V_c² / q_ci, or ASPD_SCALE = V_c / IAS, at q_ci for the constant k1."""
+    from pitotcal.core.airdata import airspeed_law
+
     qc = qci_pa / (1.0 - k1)
-    if air_data == "compressible":
-        from pitotcal.core.airdata import cas_from_qc_mps
-        vc_sq = float(cas_from_qc_mps(qc)) ** 2
-    else:
-        vc_sq = 2.0 * qc / RHO0_KGM3
+    vc_sq = float(airspeed_law(air_data)[1](qc)) ** 2
     if autopilot == "ArduPilot":
         return vc_sq / qci_pa
     return float(np.sqrt(vc_sq / (2.0 * qci_pa / RHO0_KGM3)))

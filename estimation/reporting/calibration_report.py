@@ -247,11 +247,10 @@ def _mach_rows(result):
     rows = [r for r in result.get("airspeed_correction") or [] if r.get("mach_i") is not None]
     if not rows:
         return []
-    if result.get("air_data") == "compressible":
-        from pitotcal.core.airdata import qc_from_cas_pa
-    else:
-        from pitotcal.core.units import incompressible_qc_pa as qc_from_cas_pa
+    from pitotcal.core.airdata import airspeed_law
     from pitotcal.core.units import kt_to_mps
+
+    qc_from_cas_pa = airspeed_law(result.get("air_data") or "incompressible")[0]
 
     out = []
     for r in rows:

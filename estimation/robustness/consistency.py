@@ -21,11 +21,11 @@ dependence), and the result says so.
 import numpy as np
 
 from pitotcal.core.information import normal_isf
+from pitotcal.core.measurement import flight_channels, sensitivities
 from pitotcal.core.models import delta_v_kt, get_model
 
 from ..uncertainty.covariance import colored_covariance
 from ..uncertainty.residual_noise import block_means
-from ..identification.residual import flight_channels, sensitivities
 
 __all__ = ["ALPHA", "HIDDEN_RATIO", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
            "hidden_warning", "step_test"]
@@ -74,7 +74,7 @@ def step_test(flight, result, air_data):
         The samples `result` was fitted on.
     result : IdentificationResult
     air_data : str
-        As `estimation.identification.residual.flight_channels` takes it.
+        As `pitotcal.core.measurement.flight_channels` takes it.
 
     Returns
     -------

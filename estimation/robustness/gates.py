@@ -11,6 +11,7 @@ warning per kind, naming how many and when.
 import numpy as np
 
 from pitotcal.core.information import normal_isf
+from pitotcal.core.measurement import impact_pressure_pa, tas_squared
 from pitotcal.core.units import G0_MPS2, isa_density_kgm3
 from pitotcal.io.flight_checks import PLAUSIBLE
 
@@ -83,8 +84,8 @@ def _density_gate(flight, skip):
 
 def _qci_gate(flight, skip):
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        ratio = flight.qci_pa / (0.5 * flight.rho_kgm3
-                                 * (flight.gps_vn_mps ** 2 + flight.gps_ve_mps ** 2))
+        ratio = flight.qci_pa / impact_pressure_pa(
+            flight.rho_kgm3, tas_squared(flight.gps_vn_mps, flight.gps_ve_mps, 0.0, 0.0))
     ok = ~skip & np.isfinite(ratio) & (ratio > 0)
     if not ok.any():
         return np.zeros_like(ok), "q_ci"

@@ -14,6 +14,7 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.checks import integer, number
+from pitotcal.core.measurement import StaticAir
 from pitotcal.core.models import get_model
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS, isa_temperature_k, wind_vector_mps
 from pitotcal.io.legs_csv import LegData
@@ -36,6 +37,12 @@ class LegTruth:
     dv_kt: np.ndarray
     wind_n_mps: float
     wind_e_mps: float
+
+
+def _tas_mps(qc_pa, ps_pa, oat_k):
+    """The true airspeed of a true impact pressure at the true static air: the measurement
+    model's inverse (`pitotcal.core.measurement.StaticAir`)."""
+    return np.sqrt(StaticAir(ps_pa, oat_k).tas_sq(qc_pa))
 
 
 def simulate_legs(ias_kt=(70, 85, 100, 115, 130, 145, 160), tracks_deg=(0, 90, 180, 270),
@@ -80,7 +87,7 @@ def simulate_legs(ias_kt=(70, 85, 100, 115, 130, 145, 160), tracks_deg=(0, 90, 1
     oat_k = isa_temperature_k(alt_m) if oat_c is None else number("oat_c", oat_c) + 273.15
     qci = airdata.qc_from_cas_pa(ias * KT_TO_MPS)
     qc = qci / (1.0 - pe(k, qci))
-    tas = airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)
+    tas = _tas_mps(qc, ps, oat_k)
     ps_ind = ps + (qc - qci)
     wn, we = wind_vector_mps(wind_speed_kt * KT_TO_MPS, wind_from_deg)
     w = np.array([float(wn), float(we)])
@@ -167,7 +174,7 @@ def simulate_leg_flight(ias_kt=(70, 100, 130, 160), headings_deg=(0, 90, 180, 27
     oat_k = isa_temperature_k(alt_m)
     qci = airdata.qc_from_cas_pa(ias * KT_TO_MPS)
     qc = qci / (1.0 - pe(k, qci))
-    tas = airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)
+    tas = _tas_mps(qc, ps, oat_k)
     wn, we = wind_vector_mps(wind_speed_kt * KT_TO_MPS, wind_from_deg)
     phi = np.exp(-np.mean(tas) / (rate * turbulence_length_m))
     gust = np.zeros((t.size, 2))
@@ -189,7 +196,7 @@ def simulate_leg_flight(ias_kt=(70, 100, 130, 160), headings_deg=(0, 90, 180, 27
     qci_pts = airdata.qc_from_cas_pa(ias_pts * KT_TO_MPS)
     qc_pts = qci_pts / (1.0 - pe(k, qci_pts))
     truth = LegTruth(model=pe.name, k=tuple(k), ias_kt=ias_pts,
-                     tas_mps=airdata.mach_from_qc(qc_pts, ps) * airdata.speed_of_sound_mps(oat_k),
+                     tas_mps=_tas_mps(qc_pts, ps, oat_k),
                      dv_kt=(airdata.cas_from_qc_mps(qc_pts) - ias_pts * KT_TO_MPS) / KT_TO_MPS,
                      wind_n_mps=float(wn), wind_e_mps=float(we))
     return flight, truth, windows

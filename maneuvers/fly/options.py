@@ -11,11 +11,11 @@ from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-from pitotcal.core.airdata import AIR_DATA_MODES
 from pitotcal.core.checks import choice, number, positive
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.geo import check_lat_lon
+from pitotcal.core.measurement import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from pitotcal.core.models import MODELS, get_model
 from pitotcal.core.scenario import GPS_NOISE_MAX_MPS, T2_PLAN, true_k
 
@@ -97,8 +97,8 @@ class SimulationOptions:
         update (m/s), age of the reported velocity (s).
     air_data : {"incompressible", "compressible"} or None
         True impact pressure: ½ρV_t² (the paper's eq. 2) or isentropic with the ISA p_s and T;
-        None: the engine's own (incompressible for "own", compressible for "jsbsim", the only
-        one JSBSim has).
+        None: the engine's own (for "own" the shared default `DEFAULT_AIR_DATA`, which
+        `identify` fits; "jsbsim" has only compressible).
     air_sensors : AirSensors, dict or None
         Temperature, humidity, probe-arm and GPS-bias effects (own engine only).
     gps_gm_sigma_mps, gps_gm_tau_s : float
@@ -199,7 +199,7 @@ SimOptions = SimulationOptions
 
 ENGINES = ("own", "jsbsim")
 # The true impact pressure each engine flies when `air_data` is None.
-ENGINE_AIR_DATA = {"own": "incompressible", "jsbsim": "compressible"}
+ENGINE_AIR_DATA = {"own": DEFAULT_AIR_DATA, "jsbsim": "compressible"}
 # Fields that say how to run, not what the sensors record: not in the truth's `options`
 # (the JSBSim engine adds `engine`, `aircraft` and `center_deg` itself).
 _RUN_FIELDS = ("engine", "aircraft", "center_deg", "limits", "speed_loop", "keep_history")

@@ -193,7 +193,8 @@ def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
         Flight fields: `ps_pa` (as the static port reads it), `oat_k` or `tat_k` (with bias),
         `rh_pct` if humid.
     """
-    from pitotcal.core.airdata import mach_from_tas, qc_from_tas_sq_pa
+    from pitotcal.core.airdata import mach_from_tas
+    from pitotcal.core.measurement import StaticAir, isa_air
     from pitotcal.core.moist_air import virtual_temperature_k
     from pitotcal.core.units import R_AIR_JKGK, isa_pressure_pa, isa_temperature_k
 
@@ -202,11 +203,9 @@ def air_records(time_s, states, air_data, sensors, model="inverse", k=None):
     tv = virtual_temperature_k(ts, ps, sensors.rh_pct)
     yaw_rate = (np.gradient(np.unwrap(psi), time_s) if psi.size > 1 else np.zeros_like(psi))
     v_probe = tas - yaw_rate * np.cos(bank) * sensors.probe_arm_m
-    if air_data == "compressible":
-        qc = qc_from_tas_sq_pa(v_probe ** 2, ps, tv)
-    else:
-        qc = 0.5 * ps / (R_AIR_JKGK * tv) * v_probe ** 2
-    ps_read = static_port_pa(ps, qc, model, k) if air_data == "compressible" else ps
+    true_air = isa_air(alt, air_data, oat_k=tv)         # humid air: at the virtual temperature
+    qc = true_air.qc_pa(v_probe ** 2)
+    ps_read = static_port_pa(ps, qc, model, k) if isinstance(true_air, StaticAir) else ps
     columns = {"ps_pa": ps_read}
     if sensors.tat_recovery is None:
         logged_t = columns["oat_k"] = ts + sensors.oat_bias_k

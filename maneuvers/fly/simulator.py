@@ -39,18 +39,15 @@ from .truth import (
 )
 from ..turbulence import dryden_gusts, dryden_scales
 
-from pitotcal.core.airdata import qc_from_tas_sq_pa
 from pitotcal.core.checks import integer
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.flight import Flight
-from pitotcal.core.measurement import impact_pressure_pa
+from pitotcal.core.measurement import StaticAir, isa_air
 from pitotcal.core.models import get_model
 from pitotcal.core.units import (
     G0_MPS2,
     RHO0_KGM3,
     isa_density_kgm3,
-    isa_pressure_pa,
-    isa_temperature_k,
     mps_to_kt,
     wind_polar,
     wind_vector_mps,
@@ -207,14 +204,13 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
         climb_air = (np.gradient(alt, dt) if n > 1 else np.zeros(n)) - w_up_mps
         v_air = np.sqrt(tas ** 2 + climb_air ** 2)
     rho = isa_density_kgm3(alt)
+    # the true air at the ISA state flown (`core.measurement`): what the probe and port see
+    true_air = isa_air(alt, opts.air_data)
+    qc = true_air.qc_pa(v_air ** 2)
     static = {}
-    if opts.air_data == "compressible":
-        # isentropic, at the ISA static pressure and temperature rho is made of
-        ps, oat = isa_pressure_pa(alt), isa_temperature_k(alt)
-        qc = qc_from_tas_sq_pa(v_air ** 2, ps, oat)
-        static = {"ps_pa": static_port_pa(ps, qc, opts.model, opts.k), "oat_k": oat}
-    else:
-        qc = impact_pressure_pa(rho, v_air ** 2)
+    if isinstance(true_air, StaticAir):
+        static = {"ps_pa": static_port_pa(true_air.ps, qc, opts.model, opts.k),
+                  "oat_k": true_air.oat}
     air = {}
     if opts.air_sensors is not None:      # temperature, humidity, probe arm
         qc, rho, air = air_records(t, states, opts.air_data, opts.air_sensors, opts.model,
@@ -234,7 +230,7 @@ def _record(t, states, opts, seed, rng_qc, rng_gps, w_up_mps=None):
     meta = {"generator": "pitotcal simulate", "seed": seed, "model": opts.model,
             **dict(zip(get_model(opts.model).params, opts.k)),
             "wind_speed_mps": opts.wind_speed_mps, "wind_from_deg": opts.wind_from_deg}
-    if opts.air_data != "incompressible":         # the default's CSV stays as it was
+    if opts.air_data != "incompressible":   # an incompressible flight's CSV keeps its bytes
         meta["air_data"] = opts.air_data
     flight = Flight(time_s=t, qci_pa=qci, gps_vn_mps=gps[:, 0], gps_ve_mps=gps[:, 1],
                     rho_kgm3=rho, gps_vd_mps=gps[:, 2], alt_m=alt,

@@ -19,7 +19,7 @@ def test_wind_sensitivity_is_the_analytic_one():
     # constant model (f = k1): q_ci = (1 - k1) rho |Vg - W|^2 / 2, d/dW_n = -(1 - k1) rho V cos
     psi = np.linspace(0, 2 * np.pi, 37)
     jac = qci_sensitivities(np.full(37, 40.0), psi, RHO, get_model("constant"), (0.02,),
-                            (3.0, -4.0))
+                            (3.0, -4.0), air_data="incompressible")
     np.testing.assert_allclose(jac[:, 1], -0.98 * RHO * 40.0 * np.cos(psi), rtol=1e-6,
                                atol=1e-6)
     np.testing.assert_allclose(jac[:, 2], -0.98 * RHO * 40.0 * np.sin(psi), rtol=1e-6,

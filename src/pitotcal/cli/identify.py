@@ -9,8 +9,11 @@ after the summary; the JSON and figure are written first).
 
 from pathlib import Path
 
+from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
+
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
-AIR_CHOICES = ("compressible", "incompressible")   # pitotcal.core.airdata.AIR_DATA_MODES
+# the default first, as --help and the error list them
+AIR_CHOICES = (DEFAULT_AIR_DATA, *(m for m in AIR_DATA_MODES if m != DEFAULT_AIR_DATA))
 
 
 def add_parser(subparsers):
@@ -29,7 +32,7 @@ def add_parser(subparsers):
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")
     # --- air data ---
-    p.add_argument("--air", default="compressible", metavar="MODE",
+    p.add_argument("--air", default=DEFAULT_AIR_DATA, metavar="MODE",
                    help="how impact pressure follows from true airspeed: compressible "
                         "(isentropic, from the flight's ps_pa static-port pressure and oat_k; "
                         "all pressure error taken in the static source, or separated with "

@@ -53,9 +53,10 @@ def add_parser(subparsers):
                         "airspeed includes the air-relative climb (own engine; JSBSim's "
                         "turbulence always has it)")
     g.add_argument("--air-data", default=None,
-                   help="true impact pressure from true airspeed: incompressible (1/2 rho V^2, "
-                        "the paper's eq. 2) or compressible (isentropic, ISA p and T); default "
-                        "{air_data}; JSBSim's is always compressible")
+                   help="true impact pressure from true airspeed: compressible (isentropic, "
+                        "ISA p and T; the flight gets ps_pa and oat_k) or incompressible "
+                        "(1/2 rho V^2, the paper's eq. 2); default {air_data}, as identify "
+                        "fits; JSBSim's is always compressible")
     e = p.add_argument_group("flight model")
     e.add_argument("--engine", default="own", choices=("own", "jsbsim"),
                    help="own: pitotcal's point-mass model (fast, default); jsbsim: the JSBSim "
@@ -147,8 +148,8 @@ def _outputs(args):
 def run(args):
     import warnings
 
-    from pitotcal.io import write_flight_csv
     from pitotcal.core.models import get_model
+    from pitotcal.io import write_flight_csv
     from pitotcal.io.plan_csv import read_plan
     from pitotcal.maneuvers.fly.simulator import simulate
     from pitotcal.maneuvers.fly.truth import tracking_warnings, write_truth_json

@@ -31,19 +31,21 @@ from .units import (
     ISA_T0_K,
     R_AIR_JKGK,
     RHO0_KGM3,
+    incompressible_cas_mps,
+    incompressible_qc_pa,
     isa_altitude_m,
     isa_pressure_pa,
 )
 
 __all__ = [
     "A0_MPS",
-    "AIR_DATA_MODES",
     "GAMMA",
     "P0_PA",
     "PRESSURE_ALTITUDE_MAX_M",
     "PRESSURE_ALTITUDE_MIN_M",
     "RHO0_KGM3",
     "T0_K",
+    "airspeed_law",
     "altimeter_correction_m",
     "cas_from_qc_mps",
     "mach_from_qc",
@@ -60,8 +62,6 @@ __all__ = [
     "static_pressure_pa",
 ]
 
-# How impact pressure follows from true airspeed: the paper's eq. 2 (½ρV_t²) or isentropic.
-AIR_DATA_MODES = ("incompressible", "compressible")
 GAMMA = 1.4
 P0_PA = ISA_P0_PA
 T0_K = ISA_T0_K
@@ -240,6 +240,19 @@ def qc_from_cas_pa(cas_mps, lib=np):
     """Impact pressure, Pa, of a calibrated airspeed (m/s): p₀ [(1 + 0.2 (V_c/a₀)²)^3.5 − 1]."""
     (cas_mps,) = _floats(lib, cas_mps)
     return qc_from_mach_pa(cas_mps / A0_MPS, P0_PA, lib)
+
+
+def airspeed_law(air_data):
+    """(q_c of an airspeed, airspeed of a q_c): how an airspeed indicator turns impact pressure
+    into V_i and V_c in the air-data mode `air_data` (`pitotcal.core.measurement`).
+
+    "compressible": the standard calibrated-airspeed law (`qc_from_cas_pa`, `cas_from_qc_mps`);
+    "incompressible": sqrt(2 q / ρ₀) (`pitotcal.core.units.incompressible_cas_mps`), the law
+    that goes with the paper's eq. 2.
+    """
+    if air_data == "compressible":
+        return qc_from_cas_pa, cas_from_qc_mps
+    return incompressible_qc_pa, incompressible_cas_mps
 
 
 def pressure_altitude_m(ps_pa, lib=np):

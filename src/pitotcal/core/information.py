@@ -2,7 +2,8 @@
 the pressure-error coefficients and the wind, before it is flown.
 
 The output is the measured impact pressure q_ci predicted from the GPS ground velocity through
-the measurement model (core.measurement, core.models). Its sensitivities to the unknowns
+the measurement model (core.measurement, core.models), in either air-data mode (default the
+shared `DEFAULT_AIR_DATA`, the one `identify` fits). Its sensitivities to the unknowns
 theta = (k..., wind_n, wind_e) along the trajectory form J; the residual of an unmodelled gust
 u along the flight path is q_c - q_c(no gust) ~ rho V u, so the residuals are colored:
 
@@ -25,7 +26,14 @@ numpy only; no import of maneuvers or estimation (layers).
 
 import numpy as np
 
-from .measurement import impact_pressure_pa, tas_squared
+from .measurement import (
+    DEFAULT_AIR_DATA,
+    IncompressibleAir,
+    StaticAir,
+    TotalPressureAir,
+    isa_air_of_density,
+    predict_qci_pa,
+)
 from .models import delta_v_kt, qci_from_qc_pa
 from .propagation import band, gradient
 
@@ -81,32 +89,46 @@ class ResidualNoise:
         self.gps_noise_mps, self.gps_rate_hz = float(gps_noise_mps), float(gps_rate_hz)
 
 
-def predicted_qci_pa(theta, gps_vn, gps_ve, rho_kgm3, model):
+def _air(air, air_data):
+    """An air-data object of `core.measurement` as it is; a density (kg/m³) as the ISA air of
+    that density in the mode `air_data` (`measurement.isa_air_of_density`)."""
+    if isinstance(air, (IncompressibleAir, StaticAir, TotalPressureAir)):
+        return air
+    return isa_air_of_density(air, air_data)
+
+
+def predicted_qci_pa(theta, gps_vn, gps_ve, air, model, air_data=DEFAULT_AIR_DATA):
     """q_ci the model predicts from GPS ground velocity `gps_vn`, `gps_ve` (m/s) for
-    theta = (k..., wind_n_mps, wind_e_mps): V_t^2, q_c = rho V_t^2 / 2, the sensor's q_ci."""
+    theta = (k..., wind_n_mps, wind_e_mps): `core.measurement.predict_qci_pa` with the air
+    data `air` (an air-data object, or a density taken as the ISA air of that density in the
+    mode `air_data`)."""
     theta = np.asarray(theta, dtype=float)
-    qc = impact_pressure_pa(rho_kgm3, tas_squared(gps_vn, gps_ve, theta[-2], theta[-1]))
-    return qci_from_qc_pa(model, theta[:-2], qc)
+    return predict_qci_pa(model, theta[:-2], gps_vn, gps_ve, theta[-2], theta[-1],
+                          _air(air, air_data))
 
 
-def qci_sensitivities(tas_mps, heading_rad, rho_kgm3, model, k, wind_ne_mps):
+def qci_sensitivities(tas_mps, heading_rad, air, model, k, wind_ne_mps,
+                      air_data=DEFAULT_AIR_DATA):
     """J = d q_ci / d theta, theta = (k..., wind_n, wind_e), shape (N, p + 2), Pa per unit.
 
-    Implicit differentiation of the measurement model q_ci = q_c (1 - f(k, q_ci)) at the
-    ground velocity of the planned trajectory (air velocity at `heading_rad` plus the wind),
-    q_c = rho |V_g - W|^2 / 2:
+    Implicit differentiation of the measurement model q_ci = q_c(V_t²) (1 - f(k, q_ci))
+    (`core.measurement`) at the ground velocity of the planned trajectory (air velocity at
+    `heading_rad` plus the wind), V_t² = |V_g - W|²:
 
-        d q_ci / d k_i = -q_c df/dk_i / D,   d q_ci / d W = (1 - f) (-rho (V_g - W)) / D,
-        D = 1 + q_c df/dq_ci,
+        d q_ci / d k_i = -q_c df/dk_i / D,   d q_ci / d W = (1 - f) q_c' (-2 (V_g - W)) / D,
+        D = 1 + q_c df/dq_ci,   q_c' = dq_c/dV_t² (ρ/2 incompressible),
 
     f's own derivatives by central differences (one solve of the fixed point, not one per
     unknown). V_g - W is the air velocity, so `wind_ne_mps` does not enter; it names the
-    trajectory's wind for the reader and for `predicted_qci_pa`'s theta.
+    trajectory's wind for the reader and for `predicted_qci_pa`'s theta. `air` is an air-data
+    object of `core.measurement` or a density (kg/m³), then the ISA air of that density in
+    the mode `air_data` (default the shared `DEFAULT_AIR_DATA`, as `identify` fits).
     """
     tas = np.asarray(tas_mps, dtype=float)
     psi = np.asarray(heading_rad, dtype=float)
     k = np.asarray(k, dtype=float)
-    qc = impact_pressure_pa(rho_kgm3, tas ** 2)
+    air = _air(air, air_data)
+    qc = air.qc_pa(tas ** 2)
     qci = qci_from_qc_pa(model, k, qc)
     f = model(k, qci)
     h = 1e-6 * qci
@@ -118,7 +140,7 @@ def qci_sensitivities(tas_mps, heading_rad, rho_kgm3, model, k, wind_ne_mps):
         up[i] += step
         dn[i] -= step
         cols.append(-qc * (model(up, qci) - model(dn, qci)) / (2.0 * step) / denom)
-    gain = (1.0 - f) / denom * rho_kgm3 * tas
+    gain = (1.0 - f) / denom * 2.0 * air.derivatives(tas ** 2)[0] * tas
     return np.column_stack(cols + [-gain * np.cos(psi), -gain * np.sin(psi)])
 
 
@@ -172,10 +194,11 @@ def sandwich(jac, middle):
     return cov / np.outer(scale, scale)
 
 
-def delta_v_band_kt(model, k, cov_k, vi_kt):
+def delta_v_band_kt(model, k, cov_k, vi_kt, air_data=DEFAULT_AIR_DATA):
     """Two-sigma half-width of the airspeed correction ΔV at indicated `vi_kt` (delta method,
-    the coefficients' covariance `cov_k`)."""
-    g = gradient(lambda kk: delta_v_kt(model, kk, vi_kt), k)
+    the coefficients' covariance `cov_k`), ΔV by the law of `air_data` as `identify` reports
+    it (`core.models.delta_v_kt`)."""
+    g = gradient(lambda kk: delta_v_kt(model, kk, vi_kt, air_data), k)
     return 2.0 * band(g, cov_k)
 
 

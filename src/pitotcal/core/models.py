@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import airdata
-from .units import incompressible_cas_mps, incompressible_qc_pa, kt_to_mps, mps_to_kt
+from .units import kt_to_mps, mps_to_kt
 
 __all__ = [
     "MODELS",
@@ -105,8 +105,6 @@ def delta_v_kt(model, k, vi_kt, air_data="incompressible"):
     instrument-corrected indicated airspeed V_ic and ΔV the position-error correction ΔV_pc.
     """
     vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
-    if air_data == "compressible":
-        qc = qc_from_qci_pa(model, k, airdata.qc_from_cas_pa(vi_mps))
-        return mps_to_kt(airdata.cas_from_qc_mps(qc) - vi_mps)
-    qc = qc_from_qci_pa(model, k, incompressible_qc_pa(vi_mps))
-    return mps_to_kt(incompressible_cas_mps(qc) - vi_mps)
+    qc_of, airspeed_of = airdata.airspeed_law(air_data)
+    qc = qc_from_qci_pa(model, k, qc_of(vi_mps))
+    return mps_to_kt(airspeed_of(qc) - vi_mps)

@@ -8,7 +8,8 @@ holds the airspeed within ±5 KCAS of the target and the altitude within ±50 ft
 
 from types import MappingProxyType
 
-__all__ = ["ALT_TOLERANCE_FT", "CAS_TOLERANCE_KT", "GPS_NOISE_MAX_MPS", "T2_PLAN", "TRUE_K", "true_k"]
+__all__ = ["AIR_DATA_MODES", "ALT_TOLERANCE_FT", "CAS_TOLERANCE_KT", "DEFAULT_AIR_DATA",
+           "GPS_NOISE_MAX_MPS", "T2_PLAN", "TRUE_K", "true_k"]
 
 T2_PLAN = MappingProxyType({
     "profile": "continuous", "cas_min_kt": 70.0, "cas_max_kt": 100.0, "radius_m": 926.0,
@@ -24,6 +25,13 @@ TRUE_K = MappingProxyType({
     "constant": (0.02,),
     "linear": (0.03, -1.0e-5),
 })
+
+# How impact pressure follows from true airspeed (`pitotcal.core.measurement`, which gives them
+# out with the physics; here so that the command line's parser needs no numpy): the paper's
+# eq. 2 (½ρV_t²) or isentropic. The default is the standard, isentropic relation: what
+# `simulate` flies and `identify` fits when not told otherwise.
+AIR_DATA_MODES = ("incompressible", "compressible")
+DEFAULT_AIR_DATA = "compressible"
 
 CAS_TOLERANCE_KT = 5.0      # the paper's airspeed tolerance about the target, ±KCAS
 ALT_TOLERANCE_FT = 50.0     # and the altitude tolerance, ±ft

@@ -214,7 +214,7 @@ def test_eiv_bias_below_half_sigma_at_1e6(n):
 def test_5hz_gps_held_in_7hz_data_is_detected_and_interpolated():
     """5 of every 7 samples carry a new fix (0.71): still sample-and-hold, and interpolated
     (a threshold of 0.7 left it held, which biased k2 by ~3 sigma on simulated flights)."""
-    from pitotcal.estimation.identification.eiv import gps_update_mask, interpolate_held
+    from pitotcal.core.gps_velocity import gps_update_mask, interpolate_held
 
     flight, _ = synthetic_flight(seed=3, n=2000, rate_hz=7.0, gps_rate_hz=5.0)
     assert 0.69 < gps_update_mask(flight.gps_vn_mps, flight.gps_ve_mps).mean() < 0.73

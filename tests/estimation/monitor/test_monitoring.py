@@ -66,7 +66,8 @@ def test_iid_cusum_run_length_matches_design():
 
 def test_prediction_is_the_truth_in_calm_air(plan):
     flight, truth = simulate(plan, seed=1, rate_hz=RATE_HZ, turbulence_mps=0.0,
-                             gps_noise_mps=0.0, qc_noise_pa=0.0, keep_history=True)
+                             gps_noise_mps=0.0, qc_noise_pa=0.0, keep_history=True,
+                             air_data="incompressible")
     cal = Calibration(truth.model, truth.k, truth.wind_n_mps, truth.wind_e_mps,
                       "incompressible", {})
     clean = qci_from_qc_pa(get_model(truth.model), truth.k, truth.history["qc_pa"])
@@ -126,7 +127,8 @@ def test_calibration_json_without_noise_model_warns(calibration, flown):
     d = {"model": calibration.model,
          "parameters": {"k1": {"value": calibration.k[0]}, "k2": {"value": calibration.k[1]},
                         "wind_speed_mps": {"value": 5.0}, "wind_from_deg": {"value": 270.0}},
-         "noise_std_pa": 20.0, "airspeed_correction": [{"vi_kt": 85.0}]}
+         "noise_std_pa": 20.0, "airspeed_correction": [{"vi_kt": 85.0}],
+         "air_data": calibration.air_data}
     result = monitor(flight, d)
     assert "no noise_model" in result.warnings[0]
     assert result.alarms == ()

@@ -9,6 +9,7 @@ import pytest
 from plans import circle_plan
 
 from pitotcal.core.errors import PitotcalError
+from pitotcal.core.measurement import DEFAULT_AIR_DATA
 from pitotcal.maneuvers import SimulationOptions, simulate, simulate_jsbsim
 from pitotcal.maneuvers.fly.options import AirSensors
 
@@ -80,7 +81,7 @@ def test_resolved_against_the_plan(plan):
     flight, truth = simulate(plan, SimulationOptions(k={"k2": -20.0}, rate_hz=5.0), seed=1)
     assert truth.k == (0.02, -20.0)                        # k1 the model's default
     assert truth.options["wind_speed_mps"] == plan.settings.get("wind_speed_mps", 0.0)
-    assert truth.options["air_data"] == "incompressible"
+    assert truth.options["air_data"] == DEFAULT_AIR_DATA      # the shared default identify fits
     # the truth JSON's options keep their keys: no engine or run fields for the own engine
     assert not {"engine", "aircraft", "limits", "speed_loop", "keep_history"} & set(truth.options)
 

@@ -18,6 +18,7 @@ from plans import circle_plan
 from pitotcal.core import airdata as ad
 from pitotcal.core import units
 from pitotcal.core.errors import PitotcalError
+from pitotcal.core.measurement import AIR_DATA_MODES
 from pitotcal.core.models import get_model
 
 ALT_M = 3048.0                                        # 10,000 ft
@@ -34,7 +35,7 @@ def fast_plan():
 @pytest.fixture(scope="module")
 def fits(fast_plan):
     out = {}
-    for mode in ad.AIR_DATA_MODES:
+    for mode in AIR_DATA_MODES:
         flight, truth = simulate(fast_plan, seed=3, turbulence_mps=0.0, rate_hz=10.0,
                                  air_data=mode, keep_history=True)
         out[mode] = flight, truth, identify(flight, model="inverse", air="incompressible")
@@ -54,12 +55,26 @@ def _true_corrections_kt(truth, vi_kt):
     return standard, plain, eas_kt - vi_kt
 
 
-def test_default_is_incompressible_and_unchanged(fast_plan, fits):
+def test_default_is_compressible_as_identify_fits(fast_plan, fits):
+    """simulate's default air data is identify's (one constant): compressible, with the
+    static port's ps_pa and oat_k; the incompressible flight keeps its CSV form."""
+    import inspect
+
+    from pitotcal.core.measurement import DEFAULT_AIR_DATA
+    from pitotcal.estimation import identify as identify_fn
+
+    assert DEFAULT_AIR_DATA == "compressible"
+    assert inspect.signature(identify_fn).parameters["air"].default == DEFAULT_AIR_DATA
     a, ta = simulate(fast_plan, seed=3, turbulence_mps=0.0, rate_hz=10.0)
-    b, _, _ = fits["incompressible"]
+    b, _, _ = fits["compressible"]
     np.testing.assert_array_equal(a.qci_pa, b.qci_pa)
-    assert ta.air_data == "incompressible" and "air_data" not in a.meta
-    assert ta.to_dict()["air_data"] == "incompressible"
+    np.testing.assert_array_equal(a.ps_pa, b.ps_pa)
+    np.testing.assert_array_equal(a.oat_k, b.oat_k)
+    assert ta.air_data == "compressible" and a.meta["air_data"] == "compressible"
+    assert ta.to_dict()["air_data"] == "compressible"
+    c, tc, _ = fits["incompressible"]
+    assert c.ps_pa is None and c.oat_k is None and "air_data" not in c.meta
+    assert tc.to_dict()["air_data"] == "incompressible"
 
 
 def test_compressible_truth_is_isentropic(fits, tmp_path):

@@ -1,9 +1,11 @@
-"""Errors in variables: the GPS velocity noise sigma_v, estimated from the data.
+"""The GPS velocity channels as the measurement model uses them: which samples carry a new fix,
+the velocity interpolated between held fixes, and the noise sigma_v estimated from the data.
 
 GPS velocity noise enters the predicted impact pressure squared (q_c = rho |V_g - W|^2 / 2), so
-it does not average out: it biases k1, k2 by about rho sigma_v^2 / q_c (docs/measured.md). The
-output-error problem removes that bias when it knows sigma_v (estimation/oe.py, Notes); this
-module estimates sigma_v from the velocity's high-frequency content.
+it does not average out: it biases k1, k2 by about rho sigma_v^2 / q_c (docs/measured.md), an
+error in the variables. The output-error problem removes that bias when it knows sigma_v
+(`estimation.identification.oe`, Notes); this module estimates sigma_v from the velocity's
+high-frequency content.
 """
 
 import logging
