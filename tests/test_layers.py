@@ -123,6 +123,35 @@ def test_lower_layers_import_nothing_above_them(graph, layer):
     assert {name: t for name, t in wrong.items() if t} == {}
 
 
+# Inside a layer, its topic folders in the order they may import: a module may import its own
+# topic and the topics ranked below it, never one ranked the same (a sibling) or above.
+# "__init__" is the package's own namespace; top-level modules are named by their module name.
+SUBLAYERS = {
+    "pitotcal.estimation": {"uncertainty": 0, "robustness": 1, "identification": 2,
+                            "monitor": 3, "legs": 3, "reporting": 4, "live": 5, "__init__": 6},
+    "pitotcal.maneuvers": {"turbulence": 0, "plan": 1, "fly": 2, "__init__": 3},
+    "pitotcal.studies": {"names": 0, "engine": 0, "accuracy": 1, "design": 1, "legs": 1,
+                         "monitor": 1, "peers": 1, "real_alfa": 2, "catalog": 3, "demo": 3,
+                         "__init__": 4},
+}
+
+
+def _topic(layer, name):
+    """The topic of module `name` inside `layer` ("__init__" for the layer itself)."""
+    return "__init__" if name == layer else name[len(layer) + 1:].split(".")[0]
+
+
+@pytest.mark.parametrize("layer", sorted(SUBLAYERS))
+def test_topics_import_one_way(graph, layer):
+    ranks = SUBLAYERS[layer]
+    mine = [n for n in graph if n == layer or n.startswith(layer + ".")]
+    assert {_topic(layer, n) for n in mine} <= set(ranks), "a topic with no rank in SUBLAYERS"
+    wrong = sorted((n, t) for n in mine for t in graph[n] if t.startswith(layer + ".")
+                   and _topic(layer, t) != _topic(layer, n)
+                   and ranks[_topic(layer, t)] >= ranks[_topic(layer, n)])
+    assert wrong == []
+
+
 def test_a_circle_is_found():
     assert _cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert _cycle({"a": {"b"}, "b": set()}) is None
@@ -134,17 +163,3 @@ def test_a_command_never_imports_another_command(graph):
     assert "pitotcal.cli.common" in graph["pitotcal.cli.identify"]
     assert {n: sorted(graph[n] & commands) for n in commands if graph[n] & commands} == {}
 
-
-def test_estimation_subpackages_import_one_way(graph):
-    """uncertainty -> robustness -> identification: a lower one never imports a higher one
-    (the flight's channels and the residual's sensitivities come from core.measurement)."""
-    order = ("uncertainty", "robustness", "identification")
-    prefix = "pitotcal.estimation."
-    wrong = []
-    for name, targets in graph.items():
-        if not name.startswith(prefix) or name.split(".")[2] not in order:
-            continue
-        rank = order.index(name.split(".")[2])
-        wrong += [(name, t) for t in targets if t.startswith(prefix) and len(t.split(".")) > 2
-                  and t.split(".")[2] in order[rank + 1:]]
-    assert wrong == []
