@@ -19,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pitotcal.core.checks import choice
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model, qci_from_qc_pa
 from pitotcal.core.units import (
@@ -54,7 +53,8 @@ AR_ORDER = 2
 
 @dataclass(frozen=True)
 class Calibration:
-    """A calibration as the monitor uses it (from a result JSON or an IdentificationResult)."""
+    """A calibration as the monitor uses it (from a result JSON or an IdentificationResult);
+    `notes` say what an older record lacked."""
 
     model: str
     k: tuple
@@ -63,34 +63,41 @@ class Calibration:
     air_data: str
     noise: dict
     source: str = "<memory>"
+    notes: tuple = ()
 
     @classmethod
     def from_dict(cls, d, source="<memory>"):
-        """From the JSON of `pitotcal identify --json` (docs/interfaces.md §3)."""
-        try:
-            model = get_model(d["model"])
-            par = d["parameters"]
-            k = tuple(float(par[name]["value"]) for name in model.params)
-            wn, we = wind_vector_mps(float(par["wind_speed_mps"]["value"]),
-                                     float(par["wind_from_deg"]["value"]))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise PitotcalError(f"{source}: not a pitotcal identify result JSON ({exc})",
-                                param="calibration") from None
-        air = choice("air_data", d.get("air_data", "incompressible"),
-                     ("incompressible", "compressible"))
-        noise = d.get("noise_model") or _fallback_noise(d)
-        return cls(model.name, k, float(wn), float(we), air, dict(noise), source)
+        """From the record of `pitotcal identify --json` (docs/interfaces.md §3), validated by
+        `pitotcal.io.result_record.read_result` (a PitotcalError naming `source` and the key
+        otherwise). A record without a noise model (one written before the record had it,
+        or of a flight too short for it) gets one from its residual RMS, and a note saying so.
+        """
+        from pitotcal.io.result_record import missing_record_keys, read_result, record_calibration
+
+        d = read_result(d, name=source, table=False)
+        name, k, speed, from_deg, air = record_calibration(d, source)
+        wn, we = wind_vector_mps(speed, from_deg)
+        noise, notes = d.get("noise_model"), ()
+        if noise is None:
+            noise = _fallback_noise(d)
+            why = ("written before the record had one" if "noise_model" in missing_record_keys(d)
+                   else "its flight was too short for one")
+            notes = (f"{source}: no noise_model in the calibration ({why}); residual scale "
+                     "from noise_std_pa, correlation assumed",)
+        return cls(name, k, float(wn), float(we), air, dict(noise), source, notes)
 
     @classmethod
     def from_result(cls, result, air_data="incompressible"):
-        """From an `IdentificationResult` in memory (its noise model computed here)."""
+        """From an `IdentificationResult` in memory (its noise model as `identify` computed it;
+        computed here for a result made without `identify`)."""
         wn, we = result.internal_params[-2:]
+        noise = getattr(result, "monitor_noise", None) or noise_model(result)
         return cls(result.model, tuple(map(float, result.coefficients)), float(wn), float(we),
-                   air_data, noise_model(result))
+                   air_data, noise)
 
 
 def _fallback_noise(d):
-    """A noise model from the residual RMS alone (results written before "noise_model")."""
+    """A noise model from the residual RMS alone (a record without "noise_model")."""
     rows = d.get("airspeed_correction") or []
     vi = [r["vi_kt"] for r in rows if r.get("vi_kt")]
     q_pa = 0.5 * RHO0_KGM3 * float(kt_to_mps(np.mean(vi))) ** 2 if vi else 1000.0

@@ -148,7 +148,8 @@ class LiveMonitor:
         return MonitorResult(tuple(alarms), flight.time_s, flight.qci_pa, predicted, flagged,
                              trace, self.loop.plan, dict(self.cal.noise), adapted, self.opts,
                              self.cal.air_data, flight.source, self.cal.source,
-                             tuple(warnings) + tuple(flight.warnings), extra)
+                             tuple(dict.fromkeys(self.cal.notes + tuple(warnings)
+                                                 + tuple(flight.warnings))), extra)
 
 
 def monitor(flight, calibration, options=None):
@@ -173,9 +174,6 @@ def monitor(flight, calibration, options=None):
     if cal.air_data == "compressible" and air is None:
         warnings.append(f"{flight.source}: no static pressure/temperature or altitude for the "
                         f"compressible calibration; q_ci predicted as 1/2 rho V^2")
-    if cal.noise.get("fallback"):
-        warnings.append(f"{cal.source}: no noise_model in the calibration (written before it "
-                        f"was added); residual scale from noise_std_pa, correlation assumed")
     live = LiveMonitor(cal, opts, air=air)
     live.update(flight, final=True)
     if live.n_blocks < 4:
