@@ -29,7 +29,8 @@ def to_dict(result):
         message, iterations, warnings, airspeed_correction (rows of `correction_table`, with
         dv_U_kt when there is a budget), noise_std_pa, gps_noise_std_mps, candidates,
         criterion, timing_s, air_data, consistency (when it ran), static_source (compressible),
-        source, n_dropped, uncertainty_budget (with a budget), noise_model, gps_error, reading.
+        source, n_dropped, uncertainty_budget (with a budget), noise_model (absent for a record
+        too short for it), gps_error, reading.
     """
     from .view import correction_table
 
@@ -67,8 +68,9 @@ def to_dict(result):
     out.update(source=result.source, n_dropped=int(result.n_dropped))
     if result.budget is not None:
         out = with_budget(out, result.budget)
-    out.update(noise_model=result.monitor_noise, gps_error=result.gps_error,
-               reading=result.reading)
+    if result.monitor_noise is not None:       # absent for a record too short for it
+        out["noise_model"] = result.monitor_noise
+    out.update(gps_error=result.gps_error, reading=result.reading)
     return json_ready(out)
 
 

@@ -72,7 +72,8 @@ class Calibration:
         otherwise). A record without a noise model (one written before the record had it,
         or of a flight too short for it) gets one from its residual RMS, and a note saying so.
         """
-        from pitotcal.io.result_record import missing_record_keys, read_result, record_calibration
+        from pitotcal.io.result_record import (
+            RECORD_KEYS, missing_record_keys, read_result, record_calibration)
 
         d = read_result(d, name=source, table=False)
         name, k, speed, from_deg, air = record_calibration(d, source)
@@ -80,7 +81,9 @@ class Calibration:
         noise, notes = d.get("noise_model"), ()
         if noise is None:
             noise = _fallback_noise(d)
-            why = ("written before the record had one" if "noise_model" in missing_record_keys(d)
+            # a record that has the other keys of its time lacks it for a short flight
+            why = ("written before the record had one"
+                   if set(missing_record_keys(d)) == set(RECORD_KEYS)
                    else "its flight was too short for one")
             notes = (f"{source}: no noise_model in the calibration ({why}); residual scale "
                      "from noise_std_pa, correlation assumed",)

@@ -1,4 +1,4 @@
-"""Reading and writing pitotcal's files: flight CSV, autopilot logs, plan CSV.
+"""Reading and writing pitotcal's files: flight CSV, autopilot logs, plan CSV, result records.
 
 `read_flight(path)` is the one entry point for flight data: `.ulg` (PX4 ULog), `.bin` / `.log`
 (ArduPilot DataFlash) go to `pitotcal.io.logs.read_log`; anything else is read as a flight CSV
@@ -16,6 +16,7 @@ from pitotcal.core.moist_air import check_air_options, with_static_air
 from .flight_checks import check_window
 from .flight_csv import read_flight_csv, write_flight_csv
 from .plan_csv import read_plan, write_plan
+from .result_record import read_result
 from .streams import LOG_EXTENSIONS
 
 __all__ = [
@@ -25,6 +26,7 @@ __all__ = [
     "read_flight",
     "read_flight_csv",
     "read_plan",
+    "read_result",
     "with_reading",
     "write_flight_csv",
     "write_plan",

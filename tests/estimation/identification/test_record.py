@@ -166,5 +166,7 @@ def test_an_older_record_is_read_with_a_note():
     noise model is null (a flight too short for it) says so."""
     old = Calibration.from_dict(_record(), source="old.json")
     assert old.noise.get("fallback") and "written before the record had one" in old.notes[0]
-    short = Calibration.from_dict({**_record(), "noise_model": None}, source="short.json")
-    assert "too short" in short.notes[0]
+    stated = {"stated": False, "sigma_mps": None, "tau_s": None}
+    for short in ({**_record(), "gps_error": stated}, {**_record(), "noise_model": None}):
+        cal = Calibration.from_dict(short, source="short.json")
+        assert cal.noise.get("fallback") and "too short" in cal.notes[0]
