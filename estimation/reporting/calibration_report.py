@@ -318,8 +318,8 @@ def read_result(path):
     (`legs_as_result`: its global fit, with the legs table); a one-line PitotcalError naming
     the file (and the key) when it is neither."""
     from pitotcal.io.jsonfile import read_json
-
     from pitotcal.io.result_record import read_result as read_record
+
     from ..legs.report import legs_as_result
 
     doc = read_json(path)

@@ -136,8 +136,8 @@ def run(args):
     from pitotcal.core.models import MODELS
     from pitotcal.estimation import identify
     from pitotcal.estimation.reporting.budget_tables import budget_summary
-    from pitotcal.io.jsonfile import write_json
     from pitotcal.io import is_log_file
+    from pitotcal.io.jsonfile import write_json
 
     choice("model", args.model, [*MODELS, "auto"])
     choice("air", args.air, AIR_CHOICES)
@@ -153,7 +153,7 @@ def run(args):
 
     # every file is written before anything is printed, so a reader that goes away early
     # (`| head`) never costs a file
-    if args.json is not None:
+    if args.json is not None:       # the record, with the path as given (a log's names the file)
         write_json(args.json, {**result.to_dict(), "source": str(source)})
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
