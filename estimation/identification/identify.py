@@ -39,7 +39,7 @@ def identify(flight, model="inverse", *, air="compressible", gps_noise_std_mps=N
         How the impact pressure follows from the true airspeed (`estimation.identification.residual`):
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
         temperature `oat_k`, with all the pressure error in the static source (the default),
-        or the paper's eq. 2, q_c = ½ρV_t² ("incompressible", results as before issue 9). A
+        or the paper's eq. 2, q_c = ½ρV_t² ("incompressible"). A
         flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
         an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
         it instead, and the static and total pressure errors are separated
