@@ -101,7 +101,7 @@ class LiveIdentifier:
 
     def _stated(self, flight):
         """The stated GPS error as `identify` checks it against `flight` (None: no record yet)."""
-        from .identification.identify import _gps_error
+        from .identification.fit import _gps_error
 
         return _gps_error(self.gps_error.get("gps_error_sigma_mps"),
                           self.gps_error.get("gps_error_tau_s"), flight)
@@ -109,12 +109,12 @@ class LiveIdentifier:
     def update(self, flight, warm=True):
         """The fit of `flight`; `warm=False` starts IPOPT from the linear least-squares start
         values (the cold start, for comparison)."""
-        from .identification import identify as identification
+        from .identification import fit as identification
+        from .identification.identify import identify
         from .robustness import gates
 
         if self.problem is None:
-            return identification.identify(flight, model=self.model, air=self.air,
-                                           **self.gps_error)
+            return identify(flight, model=self.model, air=self.air, **self.gps_error)
         air_data, _ = identification._air_data(flight, self.air)
         identification._check_flight(flight, air_data)
         flight, _ = gates.gate_flight(flight)
@@ -128,18 +128,29 @@ class LiveIdentifier:
 
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
                     idle_timeout_s=IDLE_TIMEOUT_S, on_fix=None, max_s=None, air=DEFAULT_AIR_DATA,
-                    gps_error=None):
+                    gps_error=None, temp_recovery=1.0, rh_pct=None, budget=None):
     """Re-identify the growing maneuver every second (warm-started, `LiveIdentifier`); returns
-    (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`
-    and the stated `gps_error`, as `LiveIdentifier` takes it) on every sample received, as
-    offline. A bad `gps_error` is refused before the stream is opened."""
+    (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`,
+    the stated `gps_error`, as `LiveIdentifier` takes it, and the uncertainty `budget`) on every
+    sample received, as offline, so its record (`to_dict`) has the offline record's keys. The
+    air data is made as `read_flight` makes it, with `temp_recovery` and `rh_pct`, and the
+    flight's `reading` records it. Bad options are refused before the stream is opened."""
+    from pitotcal.core.moist_air import check_air_options, with_static_air
+    from pitotcal.io import with_reading
+
     from .identification.identify import identify
+    from .identification.identify import budget_inputs
 
     fixes = []
     live = LiveIdentifier(model, air, gps_error)
+    temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
+    budget = budget_inputs(budget)
+
+    def air_data(buf):
+        return with_static_air(buf.flight(), temp_recovery=temp_recovery, rh_pct=rh_pct)
 
     def tick(buf):
-        flight = buf.flight()
+        flight = air_data(buf)
         if flight.time_s[-1] - flight.time_s[0] < _MIN_IDENTIFY_S:
             return
         start = time.perf_counter()
@@ -156,8 +167,9 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
 
     buf = read_stream(source, oat_k=oat_k, idle_timeout_s=idle_timeout_s, on_tick=tick,
                       max_s=max_s)
-    flight = buf.flight()
-    result = identify(flight, model=model, air=air, **live.gps_error)
+    flight = with_reading(air_data(buf), {"start_s": None, "end_s": None, "oat_k": oat_k,
+                                          "temp_recovery": temp_recovery, "rh_pct": rh_pct})
+    result = identify(flight, model=model, air=air, budget=budget, **live.gps_error)
     return result, flight, fixes, buf
 
 

@@ -51,7 +51,8 @@ class DemoResult:
     truth : pitotcal.maneuvers.fly.truth.Truth
         The simulator's truth.
     timing_s : dict
-        Seconds spent planning, simulating, identifying, writing and making the report.
+        Seconds spent planning, simulating, identifying (with the budget), writing and making
+        the report.
     """
 
     out_dir: Path
@@ -83,12 +84,9 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     import time
 
     from pitotcal.estimation import identify
-    from pitotcal.estimation.identification.budget import uncertainty_budget
-    from pitotcal.estimation.reporting.budget_tables import add_budget
     from pitotcal.maneuvers import plan_maneuver, simulate, write_truth_json
 
     from pitotcal.io import write_flight_csv, write_plan
-    from pitotcal.io.jsonfile import json_ready
 
     duration_s, rate_hz = positive("duration_s", duration_s), positive("rate_hz", rate_hz)
     out = output_folder(out_dir, "the plan, flight, result and figures")
@@ -100,11 +98,9 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     flight, truth = simulate(plan, seed=seed, **{**DEMO_SIM, "rate_hz": float(rate_hz)})
     clock["simulate"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    result = identify(flight, model="inverse")
+    # with the GUM uncertainty budget, as `pitotcal identify` gives it
+    result = identify(flight, model="inverse", budget=True)
     clock["identify"] = time.perf_counter() - t0
-    t0 = time.perf_counter()
-    budget = uncertainty_budget(flight, result)       # the GUM budget, as `identify` gives it
-    clock["budget"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
     files = {"plan_csv": out / "plan.csv", "flight_csv": out / "flight.csv",
@@ -117,7 +113,7 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     doc = result.to_dict()
     doc["truth"] = {"model": truth.model, "parameters": truth.parameters}
     doc["demo_table"] = table
-    write_json(files["result_json"], json_ready(add_budget(doc, budget)))
+    write_json(files["result_json"], doc)
     files["plan_png"] = _plan_figure(plan, out)
     files["calibration_png"] = out / "calibration.png"
     result.plot(files["calibration_png"])

@@ -169,7 +169,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
     identify's estimate without the bounds and consistency checks the budget does not use.
     """
-    from .identify import estimate
+    from .fit import estimate
 
     inputs = (inputs or BudgetInputs()).checked()
     rows = result.correction_table()

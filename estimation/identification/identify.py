@@ -1,41 +1,32 @@
-"""`identify`: the public entry point of the output-error calibration."""
+"""`identify`: the public entry point of the output-error calibration.
+
+The fit itself is `estimation.identification.fit`; `complete` adds, once, everything the result
+record carries (its JSON: `estimation.identification.record`).
+"""
 
 import dataclasses
-import functools
-import logging
 
-import numpy as np
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.measurement import DEFAULT_AIR_DATA
 
-from pitotcal.core import checks
-from pitotcal.core.measurement import AIR_DATA_MODES, DEFAULT_AIR_DATA
-from pitotcal.core.errors import FlightDataError, ObservabilityError, PitotcalError
-from pitotcal.core.models import MODELS, get_model
-from pitotcal.core.scenario import GPS_NOISE_MAX_MPS
+from ..uncertainty.block_noise import block_residual_stats
+from .budget import BudgetInputs, uncertainty_budget
+from .fit import (
+    MAX_CORRELATION,
+    MIN_QCI_SPAN,
+    MIN_SAMPLES,
+    MIN_TRACK_SPREAD_DEG,
+    estimate,
+    fit,
+    track_spread_deg,
+)
 
-from ..robustness import consistency, gates
-from .oe import OutputErrorProblem
-from .unknowns import WIND_INTERNAL
-
-__all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG", "identify"]
-
-log = logging.getLogger(__name__)
-
-MIN_SAMPLES = 50
-# Wind and calibration separate only if the track turns: up to half a circle (an out-and-back
-# line included) the wind across the track is indistinguishable from a scale error.
-MIN_TRACK_SPREAD_DEG = 180.0
-# k1 and the second coefficient separate only over a spread of q_ci: (q98 - q2) / median.
-MIN_QCI_SPAN = 0.05
-# Above this |correlation| (plain information matrix) two parameters are not separable.
-MAX_CORRELATION = 0.9995
-
-# Problems are cached per (structure, IPOPT options): building costs more than solving.
-_PROBLEMS = {}
-_TRIM_ROUNDS = 3
+__all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG",
+           "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
 
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
-             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
+             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -62,13 +53,22 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         IPOPT options (without the ``ipopt.`` prefix), e.g. ``{"max_iter": 50}``.
     gps_error_sigma_mps, gps_error_tau_s : float, optional
         The GPS receiver's Gauss-Markov velocity error (m/s, s; both or neither): known noise.
+    budget : BudgetInputs or True, optional
+        Compute the GUM uncertainty budget of the airspeed correction
+        (`estimation.identification.budget`) with these Type B inputs (True: the defaults);
+        it costs up to 14 re-solves. None (the default): no budget.
 
     Returns
     -------
     IdentificationResult
         params/std (k..., wind_speed_mps, wind_from_deg), covariance (colored-residual
         corrected) and covariance_plain, residuals, success/message/iterations, warnings
-        (the flight's own, from its reader, first), candidates/criterion with "auto", timing_s.
+        (the flight's own, from its reader, first), candidates/criterion with "auto", timing_s;
+        and the result record's products, each computed once here: `monitor_noise` (the
+        residuals' noise model `pitotcal monitor` designs from), `static_fit` (the measured
+        static-error fit, with a reference static pressure), `budget`, `gps_error` (the
+        statement), `reading` (how `read_flight` read the flight), `source`, `n_dropped`.
+        `to_dict()` is the record `pitotcal identify --json` writes.
 
     Raises
     ------
@@ -95,270 +95,54 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
-    return _identify(flight, model, air, gps_noise_std_mps, ipopt_options,
-                     (gps_error_sigma_mps, gps_error_tau_s), bounds=True)
+    inputs = budget_inputs(budget)
+    result = fit(flight, model, air=air, gps_noise_std_mps=gps_noise_std_mps,
+                 ipopt_options=ipopt_options, gps_error_sigma_mps=gps_error_sigma_mps,
+                 gps_error_tau_s=gps_error_tau_s)
+    return complete(result, flight, air=air, budget=inputs,
+                    gps_error=(gps_error_sigma_mps, gps_error_tau_s))
 
 
-def estimate(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
-             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
-    """`identify`'s estimate alone, for re-solves that use only it (`estimation.identification.budget`).
-
-    The same checks, gates, outlier trimming and fit, so the same parameters; without the
-    colored-residual covariance and the consistency checks: `covariance` is the plain one and
-    `consistency` is empty, so its bounds are not the result's.
-    """
-    return _identify(flight, model, air, gps_noise_std_mps, ipopt_options,
-                     (gps_error_sigma_mps, gps_error_tau_s), bounds=False)
-
-
-def _identify(flight, model, air, gps_noise_std_mps, ipopt_options, gps_error, *, bounds):
-    """`identify` (`bounds` True) or `estimate` (False)."""
-    checks.choice("model", model, (*MODELS, "auto"))
-    if gps_noise_std_mps is not None:
-        gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0,
-                                          GPS_NOISE_MAX_MPS)
-    ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
-    checks.choice("air", air, AIR_DATA_MODES)
-    gps_error = _gps_error(*gps_error, flight)
-    air_data, air_note = _air_data(flight, air)
-    _check_flight(flight, air_data)
-    flight, gate_note = gates.gate_flight(flight)
-    _check_flight(flight, air_data)
-    _check_track(flight)
-    result, trim_note = _fit_trimmed(flight, functools.partial(
-        _identify_any, model=model, gps_noise_std_mps=gps_noise_std_mps,
-        ipopt_options=ipopt_options, air_data=air_data, gps_error=gps_error, colored=bounds),
-        air_data, check=bounds)
-    # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
-    warn = tuple(dict.fromkeys(tuple(flight.warnings) + gate_note + trim_note
-                               + tuple(result.warnings) + air_note))
-    return dataclasses.replace(result, warnings=warn)
-
-
-def _identify_any(flight, *, model, gps_noise_std_mps, ipopt_options, air_data, gps_error,
-                  colored=True):
-    if model == "auto":        # the criterion needs the colored covariance: always computed
-        return _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data, gps_error)
-    return _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error,
-                         colored)
-
-
-def _gps_error(sigma_mps, tau_s, flight=None):
-    """(sigma_mps, tau_s) of a stated Gauss-Markov GPS velocity error, or None; both or
-    neither given; tau no shorter than the `flight`'s sample interval (a faster error is
-    white noise, which the fit measures itself)."""
-    if sigma_mps is None and tau_s is None:
+def budget_inputs(budget):
+    """`identify`'s `budget` option as checked `BudgetInputs`, or None (no budget)."""
+    if budget is None or budget is False:
         return None
-    if sigma_mps is None or tau_s is None:
-        missing = "gps_error_tau_s" if tau_s is None else "gps_error_sigma_mps"
-        raise PitotcalError(f"{missing}: state the GPS velocity error's sigma and correlation "
-                            "time together", param=missing)
-    sigma = checks.number("gps_error_sigma_mps", sigma_mps, 0.0, 10.0)
-    tau = checks.positive("gps_error_tau_s", tau_s)
-    dt = float(np.median(np.diff(flight.time_s))) if flight is not None and flight.n > 1 else 0.0
-    if tau < dt:
-        raise PitotcalError(f"gps_error_tau_s {tau:g} s is shorter than the sample interval "
-                            f"({dt:g} s): an error that fast is white noise, which the fit "
-                            f"measures itself; state a correlation time of at least {dt:g} s",
-                            param="gps_error_tau_s")
-    return sigma, tau
+    if budget is True:
+        return BudgetInputs().checked()
+    if not isinstance(budget, BudgetInputs):
+        raise PitotcalError(f"budget: expected BudgetInputs, True or None, got "
+                            f"{type(budget).__name__}", param="budget")
+    return budget.checked()
 
 
-def _fit_trimmed(flight, fit, air_data, check=True):
-    """(result, warnings): the fit, refitted without the samples `gates.outliers` finds.
+def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
+    """`result` with the record's products (the fit carries its static-error fit already,
+    `fit._with_static_fit`), each computed once.
 
-    Up to `_TRIM_ROUNDS` rounds; each refit's residuals are judged again on the kept samples.
-    More than `gates.MAX_TRIM_FRACTION` trimmed is refused: the noise is not the Gaussian
-    the bounds assume, and no trimming threshold makes them honest. `check` False skips the
-    consistency checks (`estimate`).
+    Parameters
+    ----------
+    result : IdentificationResult
+        The fit (`estimation.identification.fit.fit`).
+    flight : pitotcal.core.flight.Flight
+        The flight as given to `identify` (its `reading`, `source`, `n_dropped`).
+    air : str
+        `identify`'s air-data option (the budget's re-solves use it).
+    budget : BudgetInputs, optional
+        Checked inputs of the uncertainty budget; None: no budget.
+    gps_error : (sigma_mps, tau_s)
+        The stated GPS velocity error (None, None: none stated).
     """
-    keep = np.ones(flight.n, dtype=bool)
-    result = fit(flight)
-    for _ in range(_TRIM_ROUNDS):
-        out = gates.outliers(result.residuals_pa)
-        if not out.any():
-            break
-        keep[np.flatnonzero(keep)[out]] = False
-        if (~keep).mean() > gates.MAX_TRIM_FRACTION:
-            raise ObservabilityError(
-                f"{flight.source}: {int((~keep).sum())} samples ({100 * (~keep).mean():.1f}%) "
-                f"have residuals beyond {gates.trim_threshold(flight.n):.1f} sigma (more than "
-                f"{100 * gates.MAX_TRIM_FRACTION:.0f}%): the data cannot support a calibration; "
-                "look for a leak, a blockage or a bad channel")
-        result = fit(flight.select(keep))
-    kept = flight.select(keep) if not keep.all() else flight
-    step_note, found = consistency.check(kept, result, air_data) if result.success and check \
-        else ((), {})
-    result = dataclasses.replace(result, consistency=found)
-    if keep.all():
-        return result, step_note
-    return result, (
-        (f"{flight.source}: {int((~keep).sum())} samples trimmed as outliers (residual beyond "
-        f"{gates.trim_threshold(flight.n):.1f} sigma of the fitted noise, a false-trim rate of "
-        f"{gates.FALSE_TRIM_RATE:g} per flight under Gaussian noise) and the fit repeated "
-        f"without them: {gates.spans_text(flight.time_s, ~keep)}"),) + step_note
-
-
-def _identify_auto(flight, gps_noise_std_mps, ipopt_options, air_data, gps_error=None):
-    """Every structure in MODELS, the one with the lowest BIC kept.
-
-    BIC = N_eff ln(RSS / N) + p ln(N_eff), N_eff = N median_j(P_jj / C_jj) clipped to [1, N],
-    P the plain and C the colored-residual covariance of the lowest-RSS candidate, in the
-    solver's parameters: N divided by the variance inflation the reported bounds carry, so
-    the criterion and the bounds use one noise model. At 50 Hz the residuals are correlated
-    over hundreds of samples; the plain N would reward any extra coefficient that fits
-    turbulence. (A Bartlett long-run variance of the residuals, the earlier N_eff, made the
-    same choices on the test flights but counted about twice as many samples in turbulence,
-    because its taper underestimates the long-run variance.)
-    """
-    results, candidates = {}, []
-    for name in MODELS:
-        try:
-            results[name] = _identify_one(flight, name, gps_noise_std_mps, ipopt_options,
-                                          air_data, gps_error)
-        except ObservabilityError as exc:
-            candidates.append({"model": name, "bic": None, "error": str(exc)})
-    if not results:
-        raise ObservabilityError(f"no model structure is identifiable: {candidates[0]['error']}")
-    best_rss = min(results.values(), key=lambda r: float(r.residuals_pa @ r.residuals_pa))
-    n_eff = _effective_n(best_rss)
-    candidates += [_candidate(res, n_eff) for res in results.values()]
-    ok = [c for c in candidates if c["bic"] is not None and c["converged"]] or \
-         [c for c in candidates if c["bic"] is not None]
-    chosen = min(ok, key=lambda c: c["bic"])["model"]
-    order = {name: i for i, name in enumerate(MODELS)}
-    candidates.sort(key=lambda c: order[c["model"]])
-    return dataclasses.replace(results[chosen], candidates=tuple(candidates),
-                               criterion="BIC with effective N (N / variance inflation of the "
-                                         "colored-residual covariance)")
-
-
-def _candidate(result, n_eff):
-    """One row of `candidates`: BIC = N_eff ln(RSS / N) + p ln(N_eff) and the estimate."""
-    rss = float(result.residuals_pa @ result.residuals_pa)
-    p = result.internal_params.size
-    bic = n_eff * np.log(rss / result.n_samples) + p * np.log(n_eff)
-    return {"model": result.model, "bic": float(bic), "n_eff": float(n_eff),
-            "n_params": int(p), "noise_std_pa": result.noise_std_pa,
-            "converged": result.success,
-            "params": dict(zip(result.param_names, map(float, result.params)))}
-
-
-def _identify_one(flight, model, gps_noise_std_mps, ipopt_options, air_data, gps_error=None,
-                  colored=True):
-    m = get_model(model)
-    if len(m.params) > 1:
-        _check_qci_span(flight, m)
-    key = (model, tuple(sorted(ipopt_options.items())))
-    if key not in _PROBLEMS:
-        _PROBLEMS[key] = OutputErrorProblem(model, ipopt_options=ipopt_options)
-    result = _PROBLEMS[key].solve(flight, gps_noise_std_mps=gps_noise_std_mps,
-                                  air_data=air_data, gps_error=gps_error, colored=colored)
-    if result.success:
-        _check_information(result)
-    return result
-
-
-def _air_data(flight, air):
-    """(the air-data mode used, warnings): compressible needs the flight's ps_pa and oat_k."""
-    if air == "compressible" and flight.ps_ref_pa is not None and flight.ps_pa is not None \
-            and flight.oat_k is not None:
-        return "reference", ()
-    if air == "compressible" and (flight.ps_pa is None or flight.oat_k is None):
-        return "incompressible", ((
-            f"{flight.source}: no static pressure and temperature (ps_pa, oat_k): fitted with "
-            "the incompressible q_c = rho V_t^2 / 2 (`air` incompressible), so V_c and dV "
-            "are sqrt(2 q / rho0), not the standard calibrated airspeed; give ps_pa and oat_k "
-            "for the compressible calibration"),)
-    return air, ()
-
-
-def _check_flight(flight, air_data="incompressible"):
-    n = flight.n
-    if n < MIN_SAMPLES:
-        raise FlightDataError(f"{flight.source}: {n} samples; identification needs at least {MIN_SAMPLES}")
-    air = {"compressible": ("ps_pa", "oat_k"),
-           "reference": ("ps_pa", "oat_k", "ps_ref_pa")}.get(air_data, ())
-    for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", *air):
-        values = getattr(flight, name)
-        if values is None:
-            continue
-        if values.shape != (n,):
-            raise FlightDataError(f"{flight.source}: {name} has shape {values.shape}, expected ({n},)")
-        bad = ~np.isfinite(values)
-        if bad.any():
-            raise FlightDataError(f"{flight.source}: {name}, row {int(np.argmax(bad)) + 1}: not finite")
-        if name in air and np.any(values <= 0):
-            raise FlightDataError(f"{flight.source}: {name}, row "
-                                  f"{int(np.argmax(values <= 0)) + 1}: not positive")
-
-
-def track_spread_deg(vn_mps, ve_mps):
-    """Angular spread of the ground track, degrees: 360 minus the largest empty arc of courses."""
-    moving = np.hypot(vn_mps, ve_mps) > 1.0
-    if moving.sum() < 2:
-        return 0.0
-    course = np.sort(np.degrees(np.arctan2(ve_mps[moving], vn_mps[moving])) % 360.0)
-    gaps = np.diff(np.concatenate([course, [course[0] + 360.0]]))
-    return float(360.0 - gaps.max())
-
-
-def _check_track(flight):
-    spread = track_spread_deg(flight.gps_vn_mps, flight.gps_ve_mps)
-    if spread <= MIN_TRACK_SPREAD_DEG:
-        raise ObservabilityError(
-            f"{flight.source}: the ground track turns through only {spread:.0f} deg (need more "
-            f"than {MIN_TRACK_SPREAD_DEG:.0f}): wind and calibration cannot be separated; fly turns")
-
-
-def _check_qci_span(flight, model):
-    q2, q50, q98 = np.percentile(flight.qci_pa, [2, 50, 98])
-    span = (q98 - q2) / q50
-    if span < MIN_QCI_SPAN:
-        raise ObservabilityError(
-            f"{flight.source}: q_ci spans only {100 * span:.1f}% of its median (need "
-            f">= {100 * MIN_QCI_SPAN:.0f}%) to separate {model.params[0]} from {model.params[1]} "
-            f"in the {model.name} model; fly a speed range or use the constant model")
-
-
-def _check_information(result):
-    cov = result.internal_covariance_plain
-    s = np.sqrt(np.diag(cov))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(s, s)
-    names = tuple(get_model(result.model).params) + WIND_INTERNAL
-    np.fill_diagonal(corr, 0.0)
-    if not np.all(np.isfinite(corr)):
-        raise ObservabilityError("the information matrix is singular: wind and calibration "
-                                 "cannot be separated")
-    i, j = np.unravel_index(np.argmax(np.abs(corr)), corr.shape)
-    if abs(corr[i, j]) > MAX_CORRELATION:
-        raise ObservabilityError(
-            f"near-singular information matrix: {names[i]} and {names[j]} correlated "
-            f"{corr[i, j]:+.5f}; the data cannot separate them")
-
-
-def _effective_n(result):
-    """N / the variance inflation of the colored-residual covariance (see `_identify_auto`).
-
-    Falls back to the residuals' Bartlett long-run variance ratio when the covariance has no
-    finite positive diagonal (a solve that did not converge).
-    """
-    n = result.n_samples
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = np.diag(result.internal_covariance_plain) / np.diag(result.internal_covariance)
-    ratio = ratio[np.isfinite(ratio) & (ratio > 0)]
-    if ratio.size:
-        return float(np.clip(n * np.median(ratio), 1.0, n))
-    return _effective_n_long_run(result)
-
-
-def _effective_n_long_run(result):
-    from ..uncertainty.covariance import lag_weights, residual_acf, truncation_lag
-
-    r = result.residuals_pa
-    lag, _ = truncation_lag(r)
-    acov = residual_acf(r, lag)
-    w = lag_weights(lag)
-    long_run = acov[0] + 2.0 * float(np.sum(w[1:] * acov[1:]))
-    return float(np.clip(r.size * acov[0] / max(long_run, 1e-300), 1.0, r.size))
+    try:
+        noise = block_residual_stats(result)
+    except PitotcalError:               # too short a record for the monitor's blocks
+        noise = None
+    reading = getattr(flight, "reading", None)
+    sigma, tau = gps_error
+    result = dataclasses.replace(
+        result, monitor_noise=noise,
+        gps_error={"stated": sigma is not None, "sigma_mps": sigma, "tau_s": tau},
+        reading=None if reading is None else dict(reading), source=str(flight.source),
+        n_dropped=int(flight.n_dropped))
+    if budget is None:
+        return result
+    return dataclasses.replace(result, budget=uncertainty_budget(flight, result, budget, air=air))

@@ -63,6 +63,24 @@ class IdentificationResult:
     consistency : dict
         The step-change consistency test's numbers (`estimation.robustness.consistency.step_test`
         details; empty when it did not run): docs/interfaces.md §20.
+    static_fit : (ndarray, ndarray) or None
+        The measured static-error fit (k_static, its covariance) of a result with a reference
+        static pressure (`estimation.identification.static_source.static_error_fit`), fitted
+        once by `identify`; None otherwise.
+    monitor_noise : dict or None
+        The residuals' noise model on the monitor's blocks (`estimation.monitor.model.noise_model`;
+        the record's ``"noise_model"``); None for a record too short for it.
+    gps_error : dict or None
+        The stated GPS velocity error: {stated, sigma_mps, tau_s}.
+    reading : dict or None
+        How `pitotcal.io.read_flight` read the flight: {start_s, end_s, oat_k, temp_recovery,
+        rh_pct, oat_source}; None for a flight made in memory.
+    budget : Budget or None
+        The GUM uncertainty budget (`identify(..., budget=...)`).
+    source : str
+        The flight's source (file or stream).
+    n_dropped : int
+        Rows (or log samples) the reader dropped.
     """
 
     model: str
@@ -91,6 +109,13 @@ class IdentificationResult:
     ps_pa: np.ndarray | None = None
     ps_ref_pa: np.ndarray | None = None
     consistency: dict = field(default_factory=dict)
+    static_fit: tuple | None = None
+    monitor_noise: dict | None = None
+    gps_error: dict | None = None
+    reading: dict | None = None
+    budget: object = None
+    source: str = "<memory>"
+    n_dropped: int = 0
 
     # --- derived quantities -------------------------------------------------------------
     @property
@@ -146,15 +171,16 @@ class IdentificationResult:
         return (delta_v_kt(model, k, vi_kt, self.air_data),
                 2.0 * _band(grad, self._coef_cov(plain)))
 
-    # --- presentation (estimation/report.py) --------------------------------------------
+    # --- presentation (estimation.identification.view, .record) --------------------------------------------
     def summary(self):
         """Human summary in knots and degrees (what `pitotcal identify` prints)."""
         from .view import summary
         return summary(self)
 
     def to_dict(self):
-        """The JSON of docs/interfaces.md §3."""
-        from .view import to_dict
+        """The record `pitotcal identify --json` writes (docs/interfaces.md §3): computes
+        nothing `identify` has not (`estimation.identification.record.to_dict`)."""
+        from .record import to_dict
         return to_dict(self)
 
     def correction_table(self, step_kt=None):

@@ -29,7 +29,8 @@ from pitotcal.core.models import get_model, qc_from_qci_pa
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import kt_to_mps, m_to_ft
 
-__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "plot_altimeter_correction",
+__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "fitted_static_error",
+           "plot_altimeter_correction",
            "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",
            "static_source_products", "static_statement", "static_table_lines"]
 
@@ -66,6 +67,13 @@ def static_error_fit(result):
     k_static = np.linalg.lstsq(design, dp - qc * model(zero, qci), rcond=None)[0]
     residuals = dp - qc * model(k_static, qci)
     return k_static, colored_covariance(design, residuals).covariance
+
+
+def fitted_static_error(result):
+    """The result's own static-error fit (`identify` fits it once: `result.static_fit`); fitted
+    here only for a result made without `identify` (a budget re-solve, a live update)."""
+    fit = getattr(result, "static_fit", None)
+    return static_error_fit(result) if fit is None else fit
 
 
 def _products(model, kk, vi_kt, ps_ind_pa, n_k):
@@ -110,7 +118,7 @@ def static_source_products(result, vi_kt, plain=False):
     kk, cov = result.coefficients, result._coef_cov(plain)
     reference = result.ps_ref_pa is not None
     if reference:
-        k_static, cov_static = static_error_fit(result)
+        k_static, cov_static = fitted_static_error(result)
         kk = np.concatenate([kk, k_static])
         cov = np.block([[cov, np.zeros((n_k, n_k))], [np.zeros((n_k, n_k)), cov_static]])
     ps_ind = float(np.median(result.ps_pa))
@@ -181,7 +189,7 @@ def static_statement(result):
     """(what was assumed or measured, the static-error fit or None) of a compressible result."""
     if result.ps_ref_pa is None:
         return ASSUMED_STATIC, None
-    k_static, cov = static_error_fit(result)
+    k_static, cov = fitted_static_error(result)
     names = get_model(result.model).params
     return MEASURED_STATIC, {name: {"value": float(v), "std": float(np.sqrt(c))}
                              for name, v, c in zip(names, k_static, np.diag(cov))}

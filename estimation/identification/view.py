@@ -1,8 +1,8 @@
-"""Presentation of an `IdentificationResult`: summary text, JSON dict, correction table, figure.
+"""Presentation of an `IdentificationResult`: summary text, correction table, figure.
 
-`IdentificationResult.summary()`, `.to_dict()`, `.correction_table()` and `.plot()` delegate
-here. Numbers stay SI in the JSON (docs/interfaces.md §3, with `_kt` keys where the interface says
-knots); the human summary and the figure speak knots and degrees.
+`IdentificationResult.summary()`, `.correction_table()` and `.plot()` delegate here (its record,
+`.to_dict()`, is `estimation.identification.record`). The summary and the figure speak knots and
+degrees; nothing here re-fits: the static-source products use the result's own `static_fit`.
 
 Every 2-sigma here is the colored-residual-corrected one (`result.covariance`); the plain
 Hessian (Cramer-Rao) 2-sigma is shown beside it, in parentheses in the summary and as
@@ -16,20 +16,17 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.models import get_model
-from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, m_to_ft, mps_to_kt
-from pitotcal.io.jsonfile import json_ready
+from pitotcal.core.units import RHO0_KGM3, incompressible_cas_mps, mps_to_kt
 
 from .static_source import (
     air_data_lines,
     plot_altimeter_correction,
     plot_static_error,
-    pressure_altitude_ic_m,
     static_source_products,
-    static_statement,
     static_table_lines,
 )
 
-__all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary", "to_dict"]
+__all__ = ["correction_table", "default_step_kt", "flown_vi_kt", "plot", "summary"]
 
 # unit of each reported parameter that is not a model coefficient
 _WIND_UNITS = {"wind_speed_mps": "m/s", "wind_from_deg": "deg"}
@@ -114,57 +111,6 @@ def correction_table(result, step_kt=None):
 _STATIC_KEYS = ("mach_i", "dmach", "dmach_2sigma", "dh_ft", "dh_2sigma_ft", "dpp_qcic",
                 "dpp_qcic_2sigma")
 _REFERENCE_KEYS = ("dpt_qcic", "dpt_qcic_2sigma")
-
-
-def to_dict(result):
-    """The JSON of docs/interfaces.md §3 (plus compatible extra keys); no NaN (null instead).
-
-    Returns
-    -------
-    dict
-        model, formula, parameters {name: {value, std, std_plain, unit}}, covariance and
-        covariance_plain {names, matrix}, correlation {names, matrix}, n_samples, converged,
-        message, iterations, warnings, airspeed_correction (rows of `correction_table`),
-        noise_std_pa, gps_noise_std_mps, candidates, criterion, timing_s.
-    """
-    model = get_model(result.model)
-    units = dict(zip(model.params, model.units), **_WIND_UNITS)
-    names = list(result.param_names)
-    std, std_plain = result.std, result.std_plain
-    out = {
-        "model": result.model,
-        "formula": model.formula,
-        "parameters": {
-            name: {"value": result.params[i], "std": std[i], "std_plain": std_plain[i],
-                   "unit": units.get(name, "")}
-            for i, name in enumerate(names)},
-        "covariance": {"names": names, "matrix": result.covariance},
-        "covariance_plain": {"names": names, "matrix": result.covariance_plain},
-        "correlation": {"names": names, "matrix": result.correlation},
-        "n_samples": result.n_samples,
-        "converged": bool(result.converged),
-        "message": result.message,
-        "iterations": result.iterations,
-        "warnings": list(result.warnings),
-        "airspeed_correction": correction_table(result),
-        "noise_std_pa": result.noise_std_pa,
-        "gps_noise_std_mps": result.gps_noise_std_mps,
-        "candidates": list(result.candidates),
-        "criterion": result.criterion,
-        "timing_s": dict(result.timing_s),
-        "air_data": result.air_data,
-    }
-    if result.consistency:          # docs/interfaces.md §20
-        out["consistency"] = dict(result.consistency)
-    if _compressible(result):
-        h_ic = pressure_altitude_ic_m(result)
-        statement, fit = static_statement(result)
-        out["static_source"] = {
-            "assumed": statement,
-            "pressure_altitude_ic_ft": None if h_ic is None else float(m_to_ft(h_ic))}
-        if fit is not None:
-            out["static_source"]["k_static"] = fit
-    return json_ready(out)
 
 
 # --- human summary ----------------------------------------------------------------------

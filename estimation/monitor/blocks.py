@@ -1,7 +1,7 @@
 """The monitor's block loop, resumable: blocks are tested as they complete, so a live stream
 and a file of the same samples give the same alarms (`estimation.monitor.monitoring.LiveMonitor`).
 
-Each block: the predicted block-mean q_ci and its gradient in the wind (`monitor_model`), the
+Each block: the predicted block-mean q_ci and its gradient in the wind (`uncertainty.block_noise`), the
 relative residual, one step of the sequential tests (`monitor_cusum.SequentialTest`), and — while
 nothing is suspect — one step of the wind tracker (fast during the warm-up, then slow).
 """
@@ -11,7 +11,8 @@ import numpy as np
 from pitotcal.core.units import kt_to_mps
 
 from .cusum import STATISTICS, SequentialTest, WindTracker, design
-from .model import airspeed_residual_mps, block_stats, predict_qci_pa
+from ..uncertainty.block_noise import airspeed_residual_mps, block_stats
+from .model import predict_qci_pa
 
 __all__ = ["BlockLoop"]
 

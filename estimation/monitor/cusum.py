@@ -5,7 +5,7 @@ q_ci "liveness", with thresholds designed for a stated false-alarm rate, and the
 Statistics, each a one-sided CUSUM S = max(0, S + x − κ), alarm at S > h (Page 1954):
 
 * ``low`` / ``high``: x = ∓z, z = w/σ_w the block's innovation, w = e_k − Σ φ_i e_{k−i}, e the
-  residual in the noise model's unit (`monitor_model`: airspeed, m/s; relative for older
+  residual in the noise model's unit (`uncertainty.block_noise`: airspeed, m/s; relative for older
   calibrations); whitening turns the turbulence's colored residual into
   near-white innovations, so a jump shows at once in one innovation and a ramp as a growing
   mean (slow faults: a small κ).

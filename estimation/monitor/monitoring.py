@@ -1,7 +1,7 @@
 """`monitor`: near-real-time airspeed health monitoring from a calibration (paper section VI.B).
 
 Every BLOCK_S block of the record, q_ci is predicted from GPS velocity, the tracked wind, the
-calibration's pressure-error model and air data (`monitor_model.predict_qci_pa`), and the
+calibration's pressure-error model and air data (`monitor.model.predict_qci_pa`), and the
 measured q_ci is tested against it by the sequential tests of `monitor_cusum` with thresholds
 from the calibration's own residual noise model. The monitor adapts: during the warm-up it learns
 the flight's turbulence (residual scale and q_ci liveness) and wind, afterwards it follows them
@@ -29,7 +29,8 @@ from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import RHO0_KGM3, mps_to_kt
 
 from .cusum import MonitorOptions
-from .model import Calibration, _robust_std, air_inputs, predict_qci_pa
+from ..uncertainty.block_noise import robust_std
+from .model import Calibration, air_inputs, predict_qci_pa
 from .blocks import BlockLoop
 
 __all__ = ["LiveMonitor", "MonitorResult", "monitor"]
@@ -148,7 +149,8 @@ class LiveMonitor:
         return MonitorResult(tuple(alarms), flight.time_s, flight.qci_pa, predicted, flagged,
                              trace, self.loop.plan, dict(self.cal.noise), adapted, self.opts,
                              self.cal.air_data, flight.source, self.cal.source,
-                             tuple(warnings) + tuple(flight.warnings), extra)
+                             tuple(dict.fromkeys(self.cal.notes + tuple(warnings)
+                                                 + tuple(flight.warnings))), extra)
 
 
 def monitor(flight, calibration, options=None):
@@ -173,9 +175,6 @@ def monitor(flight, calibration, options=None):
     if cal.air_data == "compressible" and air is None:
         warnings.append(f"{flight.source}: no static pressure/temperature or altitude for the "
                         f"compressible calibration; q_ci predicted as 1/2 rho V^2")
-    if cal.noise.get("fallback"):
-        warnings.append(f"{cal.source}: no noise_model in the calibration (written before it "
-                        f"was added); residual scale from noise_std_pa, correlation assumed")
     live = LiveMonitor(cal, opts, air=air)
     live.update(flight, final=True)
     if live.n_blocks < 4:
@@ -208,7 +207,7 @@ def _classify(alarms, trace):
         # erratic: the innovations inside the episode far wider than the tracked scale (their
         # robust spread about their median: the one big innovation of a jump, or a shifted
         # mean, is a step or a drift, not erratic)
-        spread = _robust_std(z[inside]) if inside.sum() > 2 else 0.0
+        spread = robust_std(z[inside]) if inside.sum() > 2 else 0.0
         if level < -0.5:
             a.update(kind="drain", size=level, size_unit="fraction")
         elif "still" in stats or _not_following(trace, inside):

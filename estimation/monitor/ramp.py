@@ -3,7 +3,7 @@ ramp of the residual, with the unknown slope integrated over a normal prior (a m
 likelihood ratio), which a fixed-reference CUSUM sees late.
 
 A ramp of the residual, x_k = s (t_k − τ) for t_k > τ, reaches the innovations
-w_k = x_k − Σ_i φ_i x_{k−i} (φ the residual's AR coefficients, `monitor_model`) as s Δ g_m,
+w_k = x_k − Σ_i φ_i x_{k−i} (φ the residual's AR coefficients, `uncertainty.block_noise`) as s Δ g_m,
 g_m = m − Σ_i φ_i max(m − i, 0), m = k − j the blocks since the onset block j:
 g_m = (1 − Σφ_i) m + Σ i φ_i once m ≥ p. With z = w/σ_w (N(0,1) when nothing is wrong), the
 slope b = s Δ/σ_w given the prior N(0, v), S_j = Σ_{m≥1} g_m z_{j+m} and E_j = Σ_{m≥1} g_m², the

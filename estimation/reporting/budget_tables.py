@@ -1,7 +1,6 @@
 """Presentation of an uncertainty `Budget`: JSON keys, summary text, the U band of the figure.
 
-The identification's own presentation (estimation/report.py) does not know the budget; these
-functions add to what it makes:
+The budget's presentation beside the identification's own (estimation.identification.view):
 
 - `add_budget(out, budget)`: the result dict of `IdentificationResult.to_dict()` gains
   `dv_U_kt` in each `airspeed_correction` row and the top-level `uncertainty_budget` list
@@ -14,6 +13,7 @@ functions add to what it makes:
 import numpy as np
 
 from ..identification.budget import COVERAGE_K
+from ..identification.record import with_budget
 
 __all__ = ["add_budget", "budget_summary", "plot_budget_band"]
 
@@ -23,17 +23,10 @@ _HEADS = {"oat": "OAT", "humidity": "RH", "gps_velocity_bias": "GPSb", "gps_late
 
 
 def add_budget(out, budget):
-    """`out` (a result dict) with `dv_U_kt` per correction row and `uncertainty_budget`.
-
-    The rows are matched by speed: `budget` was computed over the same correction table.
-    """
-    rows = out.get("airspeed_correction", [])
-    u_by_vi = {round(float(v), 6): float(u) for v, u in zip(budget.vi_kt, budget.expanded_kt)}
-    new_rows = [{**row, "dv_U_kt": u_by_vi.get(round(float(row["vi_kt"]), 6))} for row in rows]
-    warnings = list(out.get("warnings", []))
-    warnings += [w for w in budget.warnings if w not in warnings]
-    return {**out, "airspeed_correction": new_rows, "uncertainty_budget": budget.to_list(),
-            "warnings": warnings}
+    """`out` (a result dict) with `dv_U_kt` per correction row and `uncertainty_budget`
+    (`estimation.identification.record.with_budget`; `identify(..., budget=...)` puts the
+    budget in its record itself)."""
+    return with_budget(out, budget)
 
 
 def budget_summary(result, budget):

@@ -312,25 +312,25 @@ def write_pdf(html_path, pdf_path):
 
 
 def read_result(path):
-    """The result JSON as a dict; PitotcalError naming the file when it is not one."""
-    import json
+    """The report's input as a dict: a result record, validated by the library's one reader
+    (`pitotcal.io.result_record.read_result`), or a `pitotcal legs --json` as a result
+    (`legs_as_result`: its global fit, with the legs table); a one-line PitotcalError naming
+    the file (and the key) when it is neither."""
+    from pitotcal.io.jsonfile import read_json
+    from pitotcal.io.result_record import read_result as read_record
 
-    try:
-        with open(path) as f:
-            doc = json.load(f)
-    except json.JSONDecodeError as exc:
-        raise PitotcalError(f"{path}: not a JSON file ({exc})") from None
-    except UnicodeDecodeError:
-        raise PitotcalError(f"{path}: not a JSON file (binary content)") from None
+    from ..legs.report import legs_as_result
+
+    doc = read_json(path)
     if isinstance(doc, dict) and not doc.get("airspeed_correction"):
-        from ..legs.report import legs_as_result
+        legs = legs_as_result(doc)
+        if legs is not doc and legs.get("airspeed_correction"):
+            return legs
+    return read_record(doc, name=str(path))
 
-        doc = legs_as_result(doc)
-    if not isinstance(doc, dict) or not doc.get("airspeed_correction"):
-        raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` or "
-                            "`pitotcal legs --json` (no airspeed_correction table)")
-    return doc
 
+# the reading a result records that `read_flight` takes (its "oat_source" is a description)
+_READING_OPTIONS = ("start_s", "end_s", "oat_k", "temp_recovery", "rh_pct")
 
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
@@ -339,9 +339,9 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
                 options=None):
     """Read the inputs, write the HTML report (and the JSON / PDF when asked).
 
-    `flight_options` are the reading identify used: start_s, end_s, oat_k (`read_flight`),
-    temp_recovery, rh_pct (`core.moist_air.with_static_air`); those not given (None) come from
-    the result's `reading`. The re-fit takes the result's model, air-data mode (`air_data`;
+    `flight_options` are the reading identify used: start_s, end_s, oat_k, temp_recovery,
+    rh_pct (`pitotcal.io.read_flight`, which makes the air data); those not given (None) come
+    from the result's `reading`. The re-fit takes the result's model, air-data mode (`air_data`;
     "incompressible" when it records none), GPS noise and stated GPS error (`gps_error`).
 
     Returns
@@ -353,18 +353,15 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     inputs = [("Result JSON", result_path)]
     flight = ident = None
     if flight_path is not None:
-        from pitotcal.core.moist_air import with_static_air
         from pitotcal.io import read_flight
 
         from ..identification.identify import identify
 
         # what identify recorded ("reading"), overridden by what the report was told
         opts = {k: v for src in (result.get("reading") or {}, flight_options or {})
-                for k, v in src.items() if v is not None}
-        flight = read_flight(flight_path, opts.pop("start_s", None), opts.pop("end_s", None),
-                             oat_k=opts.pop("oat_k", None))
-        # identify's temperature and humidity reading, then its air-data mode: the same fit
-        flight = with_static_air(flight, **opts)
+                for k, v in src.items() if v is not None and k in _READING_OPTIONS}
+        # the same reading and air data, then identify's air-data mode: the same fit
+        flight = read_flight(flight_path, **opts)
         stated = result.get("gps_error") or {}
         ident = identify(flight, model=result.get("model", "inverse"),
                          air=result.get("air_data", "incompressible"),

@@ -23,6 +23,7 @@ _EXPORTS = {
     "OutputErrorProblem": "pitotcal.estimation",
     "IdentificationResult": "pitotcal.estimation",
     "read_flight": "pitotcal.io",
+    "read_result": "pitotcal.io",
     "write_flight_csv": "pitotcal.io",
     "read_plan": "pitotcal.io",
     "write_plan": "pitotcal.io",

@@ -1,7 +1,7 @@
 """The fastest any detector could find a fault on a flight: an oracle told the fault's exact
 effect on the monitor's residual (its size and shape), not its onset.
 
-The oracle sees what the monitor sees, the block residuals e (`monitor_model`; in airspeed,
+The oracle sees what the monitor sees, the block residuals e (`uncertainty.block_noise`; in airspeed,
 e V_i/2, when the calibration's noise model is), whitened with the calibration's AR
 coefficients, w_k = e_k − Σ φ_i e_{k−i}, and scaled by the flight's own innovation spread (it
 knows the noise level). It knows the fault's effect d_m on e, m blocks
@@ -22,7 +22,7 @@ limit fired on an innovation of −5.1 σ where the oracle expected −6.5 σ an
 """
 
 import numpy as np
-from pitotcal.estimation.monitor.model import airspeed_residual_mps
+from pitotcal.estimation.uncertainty.block_noise import airspeed_residual_mps
 
 __all__ = ["oracle_delay_s"]
 

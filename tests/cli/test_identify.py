@@ -326,3 +326,25 @@ def test_no_flight_and_no_live_connection_says_what_to_give(capsys):
     assert capsys.readouterr().err.strip() == (
         "pitotcal identify: give the FLIGHT to identify (a flight CSV or a ULog/DataFlash log), "
         "or --live CONNECTION")
+
+
+def test_json_is_the_librarys_record(flight_csv, tmp_path, capsys):
+    """`identify --json` writes `IdentificationResult.to_dict()` of `identify` on the flight as
+    `read_flight` reads it, with the budget `identify(budget=...)` computes: the CLI adds
+    nothing (the source is the path as given)."""
+    from pitotcal.estimation import identify
+    from pitotcal.estimation.identification.budget import BudgetInputs
+    from pitotcal.io import read_flight
+
+    path, _ = flight_csv
+    out = tmp_path / "r.json"
+    assert main(["identify", str(path), "--end-s", "250", "--u-oat-k", "2",
+                 "--json", str(out)]) == 0
+    capsys.readouterr()
+    written = json.loads(out.read_text())
+    flight = read_flight(path, end_s=250.0)
+    record = json.loads(json.dumps(identify(flight, budget=BudgetInputs(u_oat_k=2.0)).to_dict()))
+    del written["timing_s"], record["timing_s"]
+    assert written == record
+    assert written["reading"]["end_s"] == 250.0 and written["source"] == str(path)
+    assert {"noise_model", "gps_error", "reading", "uncertainty_budget"} <= set(written)

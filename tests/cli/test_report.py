@@ -116,7 +116,7 @@ def test_report_reads_the_flight_as_identify_recorded(tmp_path):
                  "--end-s", "55", "--no-budget", "--json", str(result)]) == 0
     reading = json.loads(result.read_text())["reading"]
     assert reading == {"start_s": None, "end_s": 55.0, "oat_k": None, "temp_recovery": 0.8,
-                       "rh_pct": 60.0}
+                       "rh_pct": 60.0, "oat_source": "tat_k, recovery factor 0.8"}
     html = tmp_path / "r.html"
     assert main(["report", str(result), "--flight", str(csv), "-o", str(html)]) == 0
     assert "does not reproduce" not in html.read_text()

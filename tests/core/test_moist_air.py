@@ -59,29 +59,39 @@ def test_with_static_air_recovers_truth():
     n, ps, ts, rh = 20, np.full(20, 80000.0), np.full(20, 275.0), np.full(20, 60.0)
     mach = ad.mach_from_qc(3000.0, 80000.0)
     tat = ts * (1 + 0.98 * 0.2 * mach ** 2)
-    out = ma.with_static_air(_flight(ps_pa=ps, tat_k=tat, rh_pct=rh), temp_recovery=0.98)
+    raw = _flight(ps_pa=ps, tat_k=tat, rh_pct=rh)
+    out = ma.with_static_air(raw, temp_recovery=0.98)
     tv = ts / (1 - 0.6 * ma.saturation_vapour_pressure_pa(ts) / ps * (1 - 0.622))
     assert out.oat_k == pytest.approx(tv, rel=1e-12)           # humid: the virtual temperature
     assert out.rho_kgm3 == pytest.approx(ps / (R_AIR_JKGK * tv), rel=1e-12)
-    # a second call with another recovery factor converts the total temperature again
-    again = ma.with_static_air(out, temp_recovery=1.0)
-    assert again.oat_k == pytest.approx(ma.virtual_temperature_k(
+    # another recovery factor converts the raw total temperature with it
+    other = ma.with_static_air(raw, temp_recovery=1.0)
+    assert other.oat_k == pytest.approx(ma.virtual_temperature_k(
         tat / (1 + 0.2 * mach ** 2), ps, 60.0), rel=1e-12)
     # --rh-percent overrides the column; dry: oat_k is the static temperature itself
-    dry = ma.with_static_air(out, temp_recovery=0.98, rh_pct=0.0)
+    dry = ma.with_static_air(raw, temp_recovery=0.98, rh_pct=0.0)
     assert dry.oat_k == pytest.approx(ts, rel=1e-12)
     assert dry.rho_kgm3 == pytest.approx(ps / (R_AIR_JKGK * ts), rel=1e-12)
     assert n == out.n
 
 
-def test_humidity_applied_once_to_a_static_temperature():
+def test_air_data_is_made_once_when_read(tmp_path):
+    """read_flight makes the air data with the user's recovery factor and humidity, once; a
+    flight so read refuses a second conversion (which would apply the humidity twice)."""
+    from pitotcal.io import read_flight, write_flight_csv
+
     ps, ts = np.full(20, 90000.0), np.full(20, 300.0)
-    once = ma.with_static_air(_flight(ps_pa=ps, oat_k=ts, rh_pct=np.full(20, 70.0)))
-    twice = ma.with_static_air(once)
-    assert twice.oat_k == pytest.approx(once.oat_k, rel=1e-12)
-    assert once.oat_k == pytest.approx(ma.virtual_temperature_k(ts, ps, 70.0), rel=1e-12)
-    back = ma.with_static_air(once, rh_pct=0.0)
-    assert back.oat_k == pytest.approx(ts, rel=1e-10)
+    path = write_flight_csv(_flight(ps_pa=ps, oat_k=ts, rh_pct=np.full(20, 70.0)),
+                            tmp_path / "humid.csv")
+    once = read_flight(path)
+    assert once.oat_k == pytest.approx(ma.virtual_temperature_k(ts, ps, 70.0), rel=1e-10)
+    assert once.reading == {"start_s": None, "end_s": None, "oat_k": None,
+                            "temp_recovery": 1.0, "rh_pct": None,
+                            "oat_source": "oat_k"}
+    with pytest.raises(PitotcalError, match="air data was made when it was read"):
+        ma.with_static_air(once, rh_pct=0.0)
+    dry = read_flight(path, rh_pct=0.0)
+    assert dry.oat_k == pytest.approx(ts, rel=1e-10) and dry.reading["rh_pct"] == 0.0
 
 
 def test_with_static_air_untouched_and_refusals():

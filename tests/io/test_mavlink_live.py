@@ -168,3 +168,36 @@ def test_identify_live_says_where_it_listens_first(flights, tmp_path, capsys):
     assert err[0].startswith(f"pitotcal identify: listening on udp:127.0.0.1:{port} for "
                              f"MAVLink (up to {FIRST_MESSAGE_TIMEOUT_S:g} s")
     assert any("dV at" in line for line in err[1:])
+
+
+def test_live_record_has_the_offline_keys(flights, tmp_path, capsys):
+    """`identify --live --json` writes the library's record, as offline (noise model, GPS-error
+    statement, reading, budget), plus how the stream went; `monitor` reads it without falling
+    back to an assumed noise model."""
+    import json
+
+    from pitotcal.cli import main
+    from pitotcal.io import write_flight_csv
+    from pitotcal.io.result_record import read_result
+
+    _, flight = flights
+    clean = flight.window(None, 89.0)       # before the leak
+    csv = write_flight_csv(clean, tmp_path / "clean.csv")
+    assert main(["identify", str(csv), "--json", str(tmp_path / "file.json")]) == 0
+    port = free_udp_port()
+    send_flight(clean, port)
+    assert main(["identify", "--live", f"udpin:127.0.0.1:{port}", "--idle-s", "1", "--json",
+                 str(tmp_path / "live.json")]) == 0
+    capsys.readouterr()
+    offline = json.loads((tmp_path / "file.json").read_text())
+    live = json.loads((tmp_path / "live.json").read_text())
+    assert set(live) == set(offline) | {"live"}
+    assert {"noise_model", "gps_error", "reading", "uncertainty_budget"} <= set(live)
+    for section in ("noise_model", "gps_error", "reading"):
+        assert set(live[section]) == set(offline[section]), section
+    assert set(live["airspeed_correction"][0]) == set(offline["airspeed_correction"][0])
+    assert live["parameters"]["k1"]["value"] == pytest.approx(
+        offline["parameters"]["k1"]["value"], rel=1e-4)
+    cal = Calibration.from_dict(read_result(tmp_path / "live.json"), source="live.json")
+    assert cal.notes == () and "fallback" not in cal.noise
+    assert cal.noise["n_blocks"] == live["noise_model"]["n_blocks"] > 100

@@ -156,31 +156,28 @@ def run(args):
         return _run_live(args)
     import warnings
 
-    from pitotcal.core.checks import choice, number
+    from pitotcal.core.checks import choice
     from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
     from pitotcal.estimation import identify
-    from pitotcal.estimation.identification.budget import uncertainty_budget
     from pitotcal.estimation.reporting.budget_tables import budget_summary
     from pitotcal.io import is_log_file
+    from pitotcal.io.jsonfile import write_json
 
     choice("model", args.model, [*MODELS, "auto"])
     choice("air", args.air, AIR_CHOICES)
     source = Path(args.flight)
     plot_path = _checked_outputs(args, source)
-    number("temp_recovery", args.temp_recovery, 0.0, 1.0)
-    if args.rh_percent is not None:
-        number("rh_percent", args.rh_percent, 0.0, 100.0)
     inputs = None if args.no_budget else _budget_inputs(args)
     flight, autopilot, current = _read(args, source)
     result = identify(flight, model=args.model, air=args.air,
-                      gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))
-    budget = None if inputs is None else uncertainty_budget(flight, result, inputs, air=args.air)
+                      gps_noise_std_mps=args.gps_noise_mps, budget=inputs, **_gps_error(args))
+    budget = result.budget
 
-    # every file is written before anything is printed, so a reader that goes
-    # away early (`| head`) never costs a file
-    if args.json is not None:
-        _write_json(args.json, result, flight, source, budget, _gps_error(args), _reading(args))
+    # every file is written before anything is printed, so a reader that goes away early
+    # (`| head`) never costs a file
+    if args.json is not None:       # the record, with the path as given (a log's names the file)
+        write_json(args.json, {**result.to_dict(), "source": str(source)})
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
     params, refused = None, None
@@ -219,26 +216,24 @@ def _checked_outputs(args, source):
 
 
 def _read(args, source):
-    """(Flight with static air temperature, autopilot, current parameters): the autopilot
-    and its parameters only with --params (None, {} otherwise)."""
+    """(Flight with its air data made from the user's temperature source, recovery factor and
+    humidity, autopilot, current parameters): the autopilot and its parameters only with
+    --params (None, {} otherwise)."""
     from .common import oat_k_from_c
     from pitotcal.core.errors import PitotcalError
-    from pitotcal.core.moist_air import with_static_air
     from pitotcal.io import read_flight
 
-    autopilot, current = None, {}
+    air = {"oat_k": oat_k_from_c(args.oat_c), "temp_recovery": args.temp_recovery,
+           "rh_pct": args.rh_percent}
     if args.params is None:
-        flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
-                             oat_k=oat_k_from_c(args.oat_c))
-    else:
-        from pitotcal.io.param_files import read_flight_and_parameters
-        flight, autopilot, current = read_flight_and_parameters(
-            source, args.start_s, args.end_s, oat_k=oat_k_from_c(args.oat_c))
-        if autopilot is None:
-            raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
-                                "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
-        _check_params_temperature(flight, args.oat_c)
-    flight = with_static_air(flight, temp_recovery=args.temp_recovery, rh_pct=args.rh_percent)
+        return read_flight(source, start_s=args.start_s, end_s=args.end_s, **air), None, {}
+    from pitotcal.io.param_files import read_flight_and_parameters
+    flight, autopilot, current = read_flight_and_parameters(source, args.start_s, args.end_s,
+                                                            **air)
+    if autopilot is None:
+        raise PitotcalError(f"--params: {source.name} names no autopilot; give the "
+                            "ArduPilot or PX4 log (or the CSV `pitotcal convert` made of it)")
+    _check_params_temperature(flight, args.oat_c)
     return flight, autopilot, current
 
 
@@ -291,57 +286,9 @@ def _print_params(rec, path):
 
 
 def _gps_error(args):
-    """identify's stated GPS error keywords; JSON "gps_error" (docs/interfaces.md §19)."""
+    """identify's stated GPS error keywords (the record's "gps_error", docs/interfaces.md §19)."""
     return {"gps_error_sigma_mps": args.gps_error_sigma_mps,
             "gps_error_tau_s": args.gps_error_tau_s}
-
-
-def _reading(args):
-    """JSON "reading": how the flight was read and its air made (`pitotcal report --flight`
-    reads it the same way unless told otherwise)."""
-    from .common import oat_k_from_c
-
-    return {"start_s": args.start_s, "end_s": args.end_s, "oat_k": oat_k_from_c(args.oat_c),
-            "temp_recovery": args.temp_recovery, "rh_pct": args.rh_percent}
-
-
-def _write_json(path, result, flight, source, budget=None, gps_error=None, reading=None):
-    """The result JSON, with every warning the reader gave in its "warnings"."""
-    from pitotcal.estimation.reporting.budget_tables import add_budget
-    from pitotcal.io.jsonfile import json_ready, write_json
-
-    out = {**result.to_dict(), "source": str(source), "n_dropped": int(flight.n_dropped)}
-    if budget is not None:
-        out = json_ready(add_budget(out, budget))
-    # `identify` may carry the reader's warnings already: add only those it does not have
-    given = list(out.get("warnings", []))
-    out["warnings"] = given + [w for w in flight.warnings if w not in given]
-    out.update(_monitor_block_stats(result))
-    out.update(_gps_error_record(gps_error))
-    if reading is not None:
-        out["reading"] = reading
-    write_json(path, out)
-
-
-def _gps_error_record(gps_error):
-    """JSON "gps_error": the stated GPS error the bounds count, or nothing."""
-    if gps_error is None:
-        return {}
-    return {"gps_error": {"stated": gps_error["gps_error_sigma_mps"] is not None,
-                          "sigma_mps": gps_error["gps_error_sigma_mps"],
-                          "tau_s": gps_error["gps_error_tau_s"]}}
-
-
-def _monitor_block_stats(result):
-    """{"noise_model": ...}: the residuals' noise model that `pitotcal monitor` designs its
-    thresholds from; {} for a record too short."""
-    from pitotcal.core.errors import PitotcalError
-    from pitotcal.estimation.monitor.model import block_residual_stats
-
-    try:
-        return {"noise_model": block_residual_stats(result)}
-    except PitotcalError:
-        return {}
 
 
 def _run_live(args):
@@ -381,21 +328,25 @@ def _run_live(args):
     announce_stream("identify", args.live, idle_s)
     result, flight, fixes, buf = identify_stream(
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
-        oat_k=oat_k, idle_timeout_s=idle_s, on_fix=show, air=args.air, gps_error=_gps_error(args))
+        oat_k=oat_k, idle_timeout_s=idle_s,
+        on_fix=show, air=args.air, gps_error=_gps_error(args), temp_recovery=args.temp_recovery,
+        rh_pct=args.rh_percent, budget=None if args.no_budget else _budget_inputs(args))
+    # the record is the offline one (the library's), plus how the stream went
+    if args.json is not None:
+        from pitotcal.io.jsonfile import write_json
+        write_json(args.json, {**result.to_dict(), "source": args.live, "live": {
+            "updates": len(fixes), "target_2sigma_kt": args.target_2sigma_kt,
+            "target_met_at_s": met[0] if met else None, "stream_ended": buf.stopped,
+            "max_update_s": max((f.update_s for f in fixes), default=None)}})
+    if plot_path is not None:
+        _write_plot(plot_path, result, result.budget)
     print(f"Stream: {args.live} ({flight.n} samples, {flight.time_s[0]:.1f}-"
           f"{flight.time_s[-1]:.1f} s, ended: {buf.stopped}; {len(fixes)} live updates)")
     print(result.summary())
-    if args.json is not None:
-        from pitotcal.io.jsonfile import write_json
-        out = {**result.to_dict(), "source": args.live, "live": {
-            "updates": len(fixes), "target_2sigma_kt": args.target_2sigma_kt,
-            "target_met_at_s": met[0] if met else None, "stream_ended": buf.stopped,
-            "max_update_s": max((f.update_s for f in fixes), default=None)}}
-        out["warnings"] = list(out.get("warnings", [])) + list(flight.warnings)
-        out.update(_gps_error_record(_gps_error(args)))
-        write_json(args.json, out)
-        print(f"\nWrote {args.json}")
-    if plot_path is not None:
-        result.plot(plot_path)
-        print(f"Wrote {plot_path}")
+    if result.budget is not None:
+        from pitotcal.estimation.reporting.budget_tables import budget_summary
+        print("\n" + budget_summary(result, result.budget))
+    for path in (args.json, plot_path):
+        if path is not None:
+            print(f"Wrote {path}")
     return 0

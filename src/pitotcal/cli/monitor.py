@@ -62,19 +62,12 @@ def _help_constants():
 
 
 def _read_calibration(path):
-    import json
-
-    from pitotcal.core.errors import PitotcalError
+    """The `Calibration` of the record at `path` (`pitotcal.io.result_record.read_result`)."""
     from pitotcal.estimation.monitor.model import Calibration
+    from pitotcal.io.result_record import read_result
 
-    try:
-        data = json.loads(Path(path).read_text())
-    except json.JSONDecodeError as exc:
-        raise PitotcalError(f"--calibration {path}: not JSON ({exc.msg}, line {exc.lineno})"
-                            ) from None
-    if not isinstance(data, dict):
-        raise PitotcalError(f"--calibration {path}: not a pitotcal identify result JSON")
-    return Calibration.from_dict(data, source=str(path))
+    record = read_result(path, name=f"--calibration {path}", table=False)
+    return Calibration.from_dict(record, source=str(path))
 
 
 def _check_warmup(flight, warmup_s):

@@ -233,29 +233,16 @@ def _check_outputs(args, paths):
 
 def _calibration(path):
     """{"calibration": {source, model, k, air_data}} from an `identify --json` result ({} without one);
-    one line naming --calibration for a file that is not one."""
+    one line naming --calibration and the key for a file that is not one
+    (`pitotcal.io.result_record`)."""
     if path is None:
         return {}
-    import json
     from pathlib import Path
 
-    from pitotcal.core.errors import PitotcalError
-    from pitotcal.core.models import get_model
+    from pitotcal.io.result_record import read_result, record_calibration
 
-    try:
-        result = json.loads(Path(path).read_text())
-        model = get_model(result["model"])
-        k = [float(result["parameters"][name]["value"]) for name in model.params]
-    except OSError as exc:
-        raise PitotcalError(f"--calibration {path}: cannot read it ({exc.strerror})") from None
-    except (ValueError, KeyError, TypeError) as exc:
-        raise PitotcalError(f"--calibration {path}: not a pitotcal identify result (model and "
-                            f"parameters.k*.value needed; {type(exc).__name__}: {exc})") from None
-    if not all(abs(v) < float("inf") for v in k):
-        raise PitotcalError(f"--calibration {path}: coefficients must be finite, got {k}")
-    air = result.get("air_data", "incompressible")   # a result without air_data: incompressible
-    if air not in ("compressible", "incompressible"):
-        raise PitotcalError(f"--calibration {path}: air_data {air!r} is not compressible or "
-                            "incompressible")
-    return {"calibration": {"source": Path(path).name, "model": model.name, "k": k,
+    name = f"--calibration {path}"
+    model, k, _, _, air = record_calibration(
+        read_result(path, name=name, table=False), name, wind=False)
+    return {"calibration": {"source": Path(path).name, "model": model, "k": list(k),
                             "air_data": air}}

@@ -46,6 +46,9 @@ class Flight:
     tat_k, rh_pct : ndarray or None
         Total air temperature (K) and relative humidity (%), when the data has them
         (`pitotcal.core.moist_air.with_static_air` turns them into `oat_k` and `rho_kgm3`).
+    reading : dict or None
+        How `pitotcal.io.read_flight` read the file and made its air data, once: start_s,
+        end_s, oat_k, temp_recovery, rh_pct, oat_source. None for a flight made in memory.
     """
 
     time_s: np.ndarray
@@ -65,6 +68,7 @@ class Flight:
     # temperature and humidity: optional channels
     tat_k: np.ndarray | None = None
     rh_pct: np.ndarray | None = None
+    reading: dict | None = None
 
     @property
     def n(self):

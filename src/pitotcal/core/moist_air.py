@@ -17,7 +17,8 @@ RH. γ is taken as 1.4 for moist air too (the change is below 0.1 %).
 
 `with_static_air` turns a `Flight` with these columns into the Flight the estimator needs:
 `oat_k` the static temperature (virtual when humid: the compressible relations take it for
-both the density and the speed of sound) and `rho_kgm3` = p_s / (R T_v).
+both the density and the speed of sound) and `rho_kgm3` = p_s / (R T_v), once, when
+`pitotcal.io.read_flight` reads the flight.
 """
 
 import dataclasses
@@ -27,11 +28,12 @@ import numpy as np
 
 from .airdata import mach_from_qc
 from .checks import number
-from .errors import FlightDataError
+from .errors import FlightDataError, PitotcalError
 from .units import R_AIR_JKGK
 
 __all__ = [
     "EPSILON",
+    "check_air_options",
     "moist_density_kgm3",
     "saturation_vapour_pressure_pa",
     "static_temperature_k",
@@ -41,8 +43,9 @@ __all__ = [
 
 EPSILON = 0.622                       # R_d / R_v, molar mass of water over that of dry air
 _C_TO_K = 273.15
-_OAT_SOURCE = "oat_k_source"          # Flight.meta key: how oat_k was obtained
-_OAT_VIRTUAL = "oat_k_is"             # Flight.meta key: present when oat_k is virtual
+# Flight.meta keys describing the conversion (written out, never read back)
+_OAT_SOURCE = "oat_k_source"          # how oat_k was obtained
+_OAT_VIRTUAL = "oat_k_is"             # present when oat_k is virtual
 # Alduchov & Eskridge (1996) eq. 21, over water
 _AE_A_PA, _AE_B, _AE_C_C = 610.94, 17.625, 243.04
 
@@ -98,6 +101,15 @@ def static_temperature_k(tat_k, qci_pa, ps_pa, recovery=1.0):
     return np.asarray(tat_k, dtype=float) / (1.0 + recovery * 0.2 * mach ** 2)
 
 
+def check_air_options(temp_recovery=1.0, rh_pct=None):
+    """(temp_recovery, rh_pct) checked: the recovery factor in [0, 1], the humidity in
+    [0, 100] % or None; a PitotcalError naming `temp_recovery` or `rh_percent`."""
+    temp_recovery = number("temp_recovery", temp_recovery, 0.0, 1.0)
+    if rh_pct is not None:
+        rh_pct = number("rh_percent", rh_pct, 0.0, 100.0)
+    return temp_recovery, rh_pct
+
+
 def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     """The Flight the estimator needs: static `oat_k` and a density through the virtual temperature.
 
@@ -118,27 +130,28 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
         the static temperature — the virtual temperature T_v when a humidity is known
         (`meta["oat_k_is"]` says so), as the compressible relations and the density both
         need it — `rho_kgm3` = p_s / (R T_v), and the humidity used in `rh_pct`. An `oat_k`
-        converted from `tat_k` is marked in `meta["oat_k_source"]`; a second call (the
-        reader calls it with r = 1 and the file's humidity, `identify --temp-recovery` and
-        `--rh-percent` again) converts from the raw inputs again.
+        converted from `tat_k` is described in `meta["oat_k_source"]`. The conversion is made
+        once, from the raw columns, when the flight is read (`pitotcal.io.read_flight` with
+        the temperature source, recovery factor and humidity as options).
 
     Raises
     ------
     PitotcalError
-        `temp_recovery` outside [0, 1], `rh_pct` outside [0, 100].
+        `temp_recovery` outside [0, 1], `rh_pct` outside [0, 100]; a flight whose air data
+        `read_flight` has made already (its `reading` is set): read it again with the options.
     FlightDataError
         `rh_pct` given for a flight without the static pressure. (Columns `tat_k` or `rh_pct`
         without `ps_pa` are ignored with a warning, also in `Flight.warnings`: the density is
         then the file's `rho_kgm3`.)
     """
-    temp_recovery = number("temp_recovery", temp_recovery, 0.0, 1.0)
-    if rh_pct is not None:
-        rh_pct = number("rh_percent", rh_pct, 0.0, 100.0)
+    temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
+    if flight.reading is not None:
+        raise PitotcalError(f"{flight.source}: its air data was made when it was read "
+                            f"(temp_recovery {flight.reading.get('temp_recovery')}, rh_pct "
+                            f"{flight.reading.get('rh_pct')}); read it again with "
+                            "read_flight(..., temp_recovery=, rh_pct=) for other values",
+                            param="flight")
     tat, oat = flight.tat_k, flight.oat_k
-    if tat is not None and flight.meta.get(_OAT_SOURCE, "").startswith("tat_k"):
-        oat = None                    # converted before (by the reader): again, with this r
-    elif oat is not None and _OAT_VIRTUAL in flight.meta and flight.rh_pct is not None:
-        oat = _dry_from_virtual_k(oat, flight.ps_pa, flight.rh_pct)    # humidity applied before
     rh = flight.rh_pct if rh_pct is None else np.full(flight.n, rh_pct)
     if tat is None and rh is None:
         return flight
@@ -168,13 +181,3 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
         meta[_OAT_VIRTUAL] = "virtual temperature (rh_pct applied)"
     return dataclasses.replace(flight, oat_k=t_air, rho_kgm3=ps / (R_AIR_JKGK * t_air),
                                rh_pct=rh, meta=meta)
-
-
-def _dry_from_virtual_k(tv_k, ps_pa, rh_pct):
-    """T from T_v = T / (1 − (e(T)/p)(1 − ε)): a fixed point contracting by ≤ 0.3 a step."""
-    t = np.asarray(tv_k, dtype=float)
-    for _ in range(30):
-        e_pa = np.asarray(rh_pct, float) / 100.0 * saturation_vapour_pressure_pa(t)
-        t = tv_k * (1.0 - e_pa / ps_pa * (1.0 - EPSILON))
-    return t
-

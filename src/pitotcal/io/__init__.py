@@ -1,4 +1,4 @@
-"""Reading and writing pitotcal's files: flight CSV, autopilot logs, plan CSV.
+"""Reading and writing pitotcal's files: flight CSV, autopilot logs, plan CSV, result records.
 
 `read_flight(path)` is the one entry point for flight data: `.ulg` (PX4 ULog), `.bin` / `.log`
 (ArduPilot DataFlash) go to `pitotcal.io.logs.read_log`; anything else is read as a flight CSV
@@ -7,12 +7,16 @@ by `pitotcal.io.flight_csv.read_flight_csv`.
 
 from pathlib import Path
 
+import dataclasses
+
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.flight import Flight
+from pitotcal.core.moist_air import check_air_options, with_static_air
 
 from .flight_checks import check_window
 from .flight_csv import read_flight_csv, write_flight_csv
 from .plan_csv import read_plan, write_plan
+from .result_record import read_result
 from .streams import LOG_EXTENSIONS
 
 __all__ = [
@@ -22,6 +26,8 @@ __all__ = [
     "read_flight",
     "read_flight_csv",
     "read_plan",
+    "read_result",
+    "with_reading",
     "write_flight_csv",
     "write_plan",
 ]
@@ -32,7 +38,7 @@ def is_log_file(path):
     return Path(path).suffix.lower() in LOG_EXTENSIONS
 
 
-def read_flight(path, start_s=None, end_s=None, *, oat_k=None):
+def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0, rh_pct=None):
     """Read a calibration flight from a flight CSV or an autopilot log.
 
     Parameters
@@ -45,11 +51,19 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None):
         Validation (the 1 % bad-row rule) applies inside this window only.
     oat_k : float, optional
         Logs only: a measured outside air temperature, K, for the density (see `load_log`).
+    temp_recovery : float
+        Recovery factor of the total-temperature probe of a `tat_k` column, 0-1:
+        T_s = T_t / (1 + r 0.2 M²) (`pitotcal.core.moist_air.with_static_air`).
+    rh_pct : float, optional
+        Relative humidity, %, overriding an `rh_pct` column (default: the column, else dry).
 
     Returns
     -------
     Flight
-        `Flight.warnings` holds every warning the reader gave (also issued with
+        With its air data made once, here: `oat_k` the static (virtual, when humid)
+        temperature and `rho_kgm3` from it; `Flight.reading` records how (start_s, end_s,
+        oat_k, temp_recovery, rh_pct, oat_source), and `identify` puts it in the result
+        record. `Flight.warnings` holds every warning the reader gave (also issued with
         `warnings.warn`): dropped rows, sensor temperature used as OAT, corrupt data skipped.
 
     Raises
@@ -69,11 +83,32 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None):
     (16000, 'T-2')
     """
     start_s, end_s = check_window(start_s, end_s)
+    temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
+    reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
+               "temp_recovery": temp_recovery, "rh_pct": rh_pct}
     if is_log_file(path):
         from .logs import read_log
-        return read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k)
+        flight = read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k)
+        return with_reading(with_static_air(flight, temp_recovery=temp_recovery,
+                                            rh_pct=rh_pct), reading)
     if oat_k is not None:
         raise PitotcalError(f"oat_k applies to {'/'.join(LOG_EXTENSIONS)} logs only; "
                             f"{Path(path).name} is a flight CSV, whose density comes from its "
                             "rho_kgm3 or ps_pa/oat_k columns", param="oat_k")
-    return read_flight_csv(path, start_s=start_s, end_s=end_s)
+    return with_reading(read_flight_csv(path, start_s=start_s, end_s=end_s,
+                                        temp_recovery=temp_recovery, rh_pct=rh_pct), reading)
+
+
+def with_reading(flight, reading):
+    """`flight` with `reading` (start_s, end_s, oat_k, temp_recovery, rh_pct) recorded in
+    `Flight.reading`, and `oat_source`, where its temperature came from, added."""
+    meta = flight.meta
+    if meta.get("temperature_source"):
+        source = str(meta["temperature_source"])
+    elif meta.get("oat_k_source"):
+        source = str(meta["oat_k_source"])
+    elif flight.oat_k is not None:
+        source = "oat_k"
+    else:
+        source = None                   # the density is the file's rho_kgm3
+    return dataclasses.replace(flight, reading={**reading, "oat_source": source})

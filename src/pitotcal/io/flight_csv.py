@@ -54,7 +54,7 @@ import numpy as np
 
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.flight import Flight
-from pitotcal.core.moist_air import with_static_air
+from pitotcal.core.moist_air import check_air_options, with_static_air
 from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import ISA_T0_K, density_kgm3
 
@@ -109,14 +109,14 @@ WRITTEN_IF_PRESENT = ("gps_vd_mps", "alt_m", *STATIC_COLUMNS, "ps_ref_pa", *TEMP
 MIN_ROWS = 10
 
 
-def read_flight_csv(path, start_s=None, end_s=None):
+def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct=None):
     """Read and validate a flight CSV (docs/interfaces.md §1); see `read_flight` and the module notes.
 
     Parameters
     ----------
     path : str or path-like
-    start_s, end_s : float, optional
-        Time window, s.
+    start_s, end_s, temp_recovery, rh_pct : float, optional
+        Time window, s; the air data's options (`read_flight`).
 
     Returns
     -------
@@ -124,7 +124,7 @@ def read_flight_csv(path, start_s=None, end_s=None):
         SI arrays; `meta` from the ``# key: value`` lines; `n_dropped` rows dropped with a
         warning; `source` is `path` as given.
     """
-    start_s, end_s = check_window(start_s, end_s)
+    (start_s, end_s), air = check_window(start_s, end_s), check_air_options(temp_recovery, rh_pct)
     name = str(path)
     _reject_binary(path, name)
     header_line, columns, meta = _read_header(path, name)
@@ -170,7 +170,7 @@ def read_flight_csv(path, start_s=None, end_s=None):
                     rho_kgm3=np.ascontiguousarray(rho, dtype=float), source=name, meta=meta,
                     n_dropped=n_dropped, warnings=tuple(w for w in (warning, clock) if w),
                     **optional)
-    return with_static_air(flight)          # tat_k, rh_pct (core.moist_air)
+    return with_static_air(flight, temp_recovery=air[0], rh_pct=air[1])
 
 
 def csv_kind(path):

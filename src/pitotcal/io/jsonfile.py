@@ -8,7 +8,7 @@ import numpy as np
 
 from .atomic import atomic_open
 
-__all__ = ["json_ready", "write_json"]
+__all__ = ["json_ready", "read_json", "write_json"]
 
 
 def json_ready(value):
@@ -38,3 +38,22 @@ def write_json(path, obj):
         json.dump(json_ready(obj), f, indent=2, allow_nan=False)
         f.write("\n")
     return path
+
+
+def read_json(path, name=None):
+    """The content of the JSON file `path`; a one-line PitotcalError naming `name` (default the
+    path) when it cannot be read or is not JSON."""
+    from pitotcal.core.errors import PitotcalError
+
+    label = str(path) if name is None else name
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except json.JSONDecodeError as exc:
+        raise PitotcalError(f"{label}: not JSON ({exc.msg}, line {exc.lineno}); not a JSON "
+                            "file pitotcal wrote") from None
+    except UnicodeDecodeError:
+        raise PitotcalError(f"{label}: not JSON (binary content); not a JSON file pitotcal "
+                            "wrote") from None
+    except OSError as exc:
+        raise PitotcalError(f"{label}: cannot read it ({exc.strerror})") from None

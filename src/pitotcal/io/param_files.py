@@ -25,23 +25,32 @@ ARDUPILOT_RATIO = "ARSPD_RATIO"
 PX4_SCALES = ("ASPD_SCALE_1", "ASPD_SCALE")
 
 
-def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None):
-    """(Flight, autopilot, {parameter: current value}) of a log or a converted flight CSV.
+def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None,
+                               temp_recovery=1.0, rh_pct=None):
+    """(Flight, autopilot, {parameter: current value}) of a log or a converted flight CSV,
+    the flight read as `read_flight` reads it (its air data made with `temp_recovery`, `rh_pct`).
 
     `autopilot` is "ArduPilot", "PX4", or None when nothing says which autopilot flew it.
     """
-    from . import is_log_file, read_flight
+    from pitotcal.core.moist_air import check_air_options, with_static_air
+
+    from . import is_log_file, read_flight, with_reading
     from .flight_checks import check_window
 
     if is_log_file(path):
         from .logs import load_log
 
         start_s, end_s = check_window(start_s, end_s)
+        temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
         log = load_log(path, start_s, end_s, oat_k=oat_k)
         params = dict(log.airspeed_scale)
         autopilot = "PX4" if Path(path).suffix.lower() == ".ulg" else "ArduPilot"
-        return log.flight, autopilot, params
-    flight = read_flight(path, start_s, end_s, oat_k=oat_k)
+        flight = with_static_air(log.flight, temp_recovery=temp_recovery, rh_pct=rh_pct)
+        return with_reading(flight, {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
+                                     "temp_recovery": temp_recovery, "rh_pct": rh_pct}), \
+            autopilot, params
+    flight = read_flight(path, start_s, end_s, oat_k=oat_k, temp_recovery=temp_recovery,
+                         rh_pct=rh_pct)
     params = {}
     for key, text in flight.meta.items():
         if key.startswith("autopilot_") and key[10:] in (ARDUPILOT_RATIO, *PX4_SCALES):

@@ -4,7 +4,8 @@ import json
 
 import numpy as np
 import pytest
-from pitotcal.estimation.identification.view import correction_table, default_step_kt, flown_vi_kt, to_dict
+from pitotcal.estimation.identification.record import to_dict
+from pitotcal.estimation.identification.view import correction_table, default_step_kt, flown_vi_kt
 from pitotcal.estimation.identification.result import IdentificationResult
 from synthetic import synthetic_flight
 

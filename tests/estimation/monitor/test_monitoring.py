@@ -164,7 +164,7 @@ def test_ar2_fit_whitening_and_variance_ratio():
     """The noise model's AR(2) fit recovers a known process; var(e)/var(w) is the closed form
     (1 − φ2)/((1 + φ2)((1 − φ2)² − φ1²)); the monitor's innovations of it are white N(0,1)."""
     from pitotcal.estimation.monitor.cusum import SequentialTest, design, variance_ratio
-    from pitotcal.estimation.monitor.model import _ar_fit
+    from pitotcal.estimation.uncertainty.block_noise import _ar_fit
 
     phi1, phi2 = 1.10, -0.15
     rng = np.random.default_rng(3)

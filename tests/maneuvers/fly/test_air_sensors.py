@@ -49,9 +49,8 @@ def test_sensor_records_against_truth(tmp_path):
     with open(path) as f:
         header = next(line for line in f if not line.startswith("#"))
     assert header.strip().endswith("ps_pa,tat_k,rh_pct")
-    # the reader converts with r = 1; identify --temp-recovery 0.97 converts again
-    from pitotcal.core.moist_air import with_static_air
-    back = with_static_air(read_flight(path), temp_recovery=0.97)
+    # the reader converts with the probe's recovery factor (identify --temp-recovery 0.97)
+    back = read_flight(path, temp_recovery=0.97)
     ts = isa_temperature_k(flight.alt_m)
     # humid: oat_k is the virtual temperature; M from the measured q_ci (its pressure error
     # and noise) instead of the true one

@@ -1,0 +1,156 @@
+"""Reading a result record (`pitotcal identify --json`, docs/interfaces.md §3): the one
+reader, for `identify --live`, `report`, `monitor` and `plan --calibration` alike.
+
+`read_result` validates what it returns: a missing or wrong-typed key is a one-line
+PitotcalError naming the file and the key. Records written before the noise model, the stated
+GPS error and the reading were part of them (`RECORD_KEYS`) are read as they are;
+`missing_record_keys` says what they lack, for a warning.
+"""
+
+import math
+
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.models import MODELS, get_model
+
+from .jsonfile import read_json
+
+__all__ = ["RECORD_KEYS", "missing_record_keys", "read_result", "record_calibration"]
+
+# Keys a record holds since the monitor's noise model, the stated GPS error and the reading
+# were added to it.
+RECORD_KEYS = ("noise_model", "gps_error", "reading")
+_AIR_DATA = ("incompressible", "compressible")
+_WIND = ("wind_speed_mps", "wind_from_deg")
+
+_NUMBER = (int, float)
+# (key, accepted types, description); checked when present, the first three also required
+_TOP = (
+    ("airspeed_correction", list, "a list of rows"),
+    ("model", str, "a model name"),
+    ("parameters", dict, "an object"),
+    ("air_data", str, "compressible or incompressible"),
+    ("converged", bool, "true or false"),
+    ("warnings", list, "a list"),
+    ("noise_std_pa", (*_NUMBER, type(None)), "a number"),
+    ("gps_noise_std_mps", (*_NUMBER, type(None)), "a number"),
+    ("noise_model", (dict, type(None)), "an object or null"),
+    ("gps_error", (dict, type(None)), "an object or null"),
+    ("reading", (dict, type(None)), "an object or null"),
+    ("uncertainty_budget", list, "a list"),
+    ("static_source", dict, "an object"),
+)
+_REQUIRED = 3
+# every row has its speed; the correction and its 2-sigma are checked when present
+_ROW_KEYS = ("vi_kt", "dv_kt", "dv_2sigma_kt")
+
+
+def read_result(source, *, name=None, table=True):
+    """A result record of `pitotcal identify --json`, validated.
+
+    Parameters
+    ----------
+    source : str, path-like or dict
+        The JSON file, or its content already parsed.
+    name : str, optional
+        How errors name the record (e.g. ``"--calibration result.json"``); default the path,
+        or ``"<memory>"`` for a dict.
+    table : bool
+        Require the airspeed-correction table (a report does; the monitor and the planner use
+        only the model, its coefficients and the wind).
+
+    Returns
+    -------
+    dict
+        The record (a shallow copy). Keys an older record lacks (`RECORD_KEYS`) stay absent:
+        `missing_record_keys` lists them.
+
+    Raises
+    ------
+    PitotcalError
+        One line naming the file and the key: not JSON, not an object, a required key
+        (airspeed_correction with each row's vi_kt, model, parameters with each
+        coefficient's value) missing, or any known key of the wrong type (the wind's
+        parameters included).
+    """
+    if isinstance(source, dict):
+        label, doc = name or "<memory>", source
+    else:
+        label = name or str(source)
+        doc = read_json(source, label)
+    if not isinstance(doc, dict):
+        raise PitotcalError(f"{label}: not a pitotcal identify result JSON (not an object)")
+    for i, (key, types, what) in enumerate(_TOP):
+        if key not in doc:
+            if i < _REQUIRED and (table or key != "airspeed_correction"):
+                missing = "airspeed_correction table" if i == 0 else f"key '{key}'"
+                raise PitotcalError(f"{label}: not a pitotcal identify result JSON "
+                                    f"(no {missing})")
+            continue
+        _check_type(label, key, doc[key], types, what)
+    if table and not doc["airspeed_correction"]:
+        raise PitotcalError(f"{label}: not a pitotcal identify result JSON (no "
+                            "airspeed_correction table: the list is empty)")
+    for j, row in enumerate(doc.get("airspeed_correction", ())):
+        _check_type(label, f"airspeed_correction[{j}]", row, dict, "an object")
+        for key in _ROW_KEYS:
+            if key == "vi_kt" or key in row:
+                _check_number(label, f"airspeed_correction[{j}].{key}", row, key)
+    if doc["model"] not in MODELS:
+        raise PitotcalError(f"{label}: not a pitotcal identify result JSON: key 'model' is "
+                            f"{doc['model']!r}, not one of "
+                            f"{', '.join(MODELS)}")
+    if doc.get("air_data", "incompressible") not in _AIR_DATA:
+        raise PitotcalError(f"{label}: not a pitotcal identify result JSON: key 'air_data' is "
+                            f"{doc['air_data']!r}, not "
+                            f"{' or '.join(_AIR_DATA)}")
+    for par in (*get_model(doc["model"]).params, *_WIND):
+        if par in _WIND and par not in doc["parameters"]:
+            continue                    # needed by the monitor only: `record_calibration`
+        entry = doc["parameters"].get(par)
+        _check_type(label, f"parameters.{par}", entry, dict, "an object with a value")
+        _check_number(label, f"parameters.{par}.value", entry, "value")
+    return dict(doc)
+
+
+def _check_type(label, key, value, types, what):
+    # bool is an int to isinstance: a number key must not take true/false
+    wrong_bool = isinstance(value, bool) and bool not in (types if isinstance(types, tuple)
+                                                          else (types,))
+    if wrong_bool or not isinstance(value, types):
+        raise PitotcalError(f"{label}: not a pitotcal identify result JSON: key '{key}' is "
+                            f"{_json_type(value)}, expected {what}")
+
+
+def _check_number(label, key, entry, field):
+    if field not in entry:
+        raise PitotcalError(f"{label}: not a pitotcal identify result JSON (no key '{key}')")
+    _check_type(label, key, entry[field], (*_NUMBER, type(None)), "a number")
+
+
+def _json_type(value):
+    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean",
+            type(None): "null"}.get(type(value), "a number")
+
+
+def missing_record_keys(record):
+    """The `RECORD_KEYS` an (older) record lacks."""
+    return tuple(key for key in RECORD_KEYS if key not in record)
+
+
+def record_calibration(record, name="<memory>", wind=True):
+    """(model, k, wind_speed_mps, wind_from_deg, air_data) of a validated record; a
+    PitotcalError naming `name` and the key when a value the calibration needs is not finite
+    (a solve that did not converge writes null). `wind` False: the wind is not needed (None)."""
+    model = get_model(record["model"])
+    values = {}
+    for par in (*model.params, *(_WIND if wind else ())):
+        if par not in record["parameters"]:
+            raise PitotcalError(f"{name}: not a pitotcal identify result JSON (no key "
+                                f"'parameters.{par}')")
+        value = record["parameters"][par]["value"]
+        if value is None or not math.isfinite(value):
+            raise PitotcalError(f"{name}: key 'parameters.{par}.value' is {value}, not a "
+                                "finite number: the result is not a calibration")
+        values[par] = float(value)
+    return (model.name, tuple(values[p] for p in model.params), values.get(_WIND[0]),
+            values.get(_WIND[1]), record.get("air_data", "incompressible"))
