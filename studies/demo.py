@@ -120,7 +120,7 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     write_json(files["result_json"], json_ready(add_budget(doc, budget)))
     files["plan_png"] = _plan_figure(plan, out)
     files["calibration_png"] = out / "calibration.png"
-    result.plot(files["calibration_png"])
+    _calibration_figure(result, budget, files["calibration_png"])
     files["residuals_png"] = _residual_figure(result, out)
     clock["write"] = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -170,6 +170,17 @@ def _report(result, flight, files, out):
     path = out / "report.html"
     with atomic_open(path, "w", encoding="utf-8") as fh:
         fh.write(render_html(context))
+    return path
+
+
+def _calibration_figure(result, budget, path):
+    """The paper-style calibration figure with the budget's U band on its ΔV panel."""
+    from pitotcal.estimation.reporting.budget_tables import plot_budget_band
+    from pitotcal.io.atomic import save_figure
+
+    fig = result.plot()
+    plot_budget_band(fig.axes[0], result, budget)
+    save_figure(fig, path, dpi=110)
     return path
 
 

@@ -1,11 +1,11 @@
 """Presentation of an uncertainty `Budget`: JSON keys, summary text, the U band of the figure.
 
-The identification's own presentation (estimation/report.py) does not know the budget; these
-functions add to what it makes:
+The identification's own presentation (estimation/identification/view.py) does not know the
+budget; these functions add to what it makes:
 
 - `add_budget(out, budget)`: the result dict of `IdentificationResult.to_dict()` gains
-  `dv_U_kt` in each `airspeed_correction` row and the top-level `uncertainty_budget` list
-  (docs/interfaces.md, "Uncertainty budget");
+  `dv_U_kt` and `u_dv_by_source_kt` in each `airspeed_correction` row and the top-level
+  `uncertainty_budget` list (docs/interfaces.md, "Uncertainty budget");
 - `budget_summary(result, budget)`: the text printed after the summary;
 - `plot_budget_band(ax, result, budget)`: the expanded-uncertainty band on the ΔV axes of the
   calibration figure (`IdentificationResult.plot` returns the figure; its first axes).
@@ -15,21 +15,42 @@ import numpy as np
 
 from ..identification.budget import COVERAGE_K
 
-__all__ = ["add_budget", "budget_summary", "plot_budget_band"]
+__all__ = ["SOURCE_LABELS", "add_budget", "budget_summary", "plot_budget_band", "source_label"]
 
-# short column heads of the per-speed table, in SOURCES order
-_HEADS = {"oat": "OAT", "humidity": "RH", "gps_velocity_bias": "GPSb", "gps_latency": "lat",
-          "probe_lever_arm": "arm", "qc_scale": "scale", "qc_offset": "offs"}
+# each source of the budget in words (report tables) and as a short column head (summary
+# text), in SOURCES order after the statistical term
+SOURCE_LABELS = {"statistical": ("Statistical (the fit's 2σ / 2)", "stat"),
+                 "oat": ("Outside air temperature", "OAT"),
+                 "humidity": ("Relative humidity", "RH"),
+                 "gps_velocity_bias": ("GPS velocity bias", "GPSb"),
+                 "gps_latency": ("GPS latency", "lat"),
+                 "probe_lever_arm": ("Probe lever arm", "arm"),
+                 "qc_scale": ("Impact-pressure transducer scale", "scale"),
+                 "qc_offset": ("Impact-pressure transducer offset", "offs")}
+_HEADS = {k: short for k, (_, short) in SOURCE_LABELS.items()}
+
+
+def source_label(name):
+    """A budget source in words (the name itself, spaced, when it is not one of ours)."""
+    return SOURCE_LABELS.get(name, (name.replace("_", " "), name))[0]
 
 
 def add_budget(out, budget):
-    """`out` (a result dict) with `dv_U_kt` per correction row and `uncertainty_budget`.
+    """`out` (a result dict) with `dv_U_kt` and `u_dv_by_source_kt` (each source's standard
+    uncertainty of ΔV at that speed, kt) per correction row, and `uncertainty_budget`.
 
     The rows are matched by speed: `budget` was computed over the same correction table.
     """
     rows = out.get("airspeed_correction", [])
-    u_by_vi = {round(float(v), 6): float(u) for v, u in zip(budget.vi_kt, budget.expanded_kt)}
-    new_rows = [{**row, "dv_U_kt": u_by_vi.get(round(float(row["vi_kt"]), 6))} for row in rows]
+    at = {round(float(v), 6): i for i, v in enumerate(budget.vi_kt)}
+    new_rows = []
+    for row in rows:
+        i = at.get(round(float(row["vi_kt"]), 6))
+        extra = {"dv_U_kt": None} if i is None else {
+            "dv_U_kt": float(budget.expanded_kt[i]),
+            "u_dv_by_source_kt": {"statistical": float(budget.statistical_kt[i]),
+                                  **{n: float(u[i]) for n, u in budget.terms_kt.items()}}}
+        new_rows.append({**row, **extra})
     warnings = list(out.get("warnings", []))
     warnings += [w for w in budget.warnings if w not in warnings]
     return {**out, "airspeed_correction": new_rows, "uncertainty_budget": budget.to_list(),
@@ -67,12 +88,9 @@ def plot_budget_band(ax, result, budget):
 
     Between the table's speeds U is interpolated linearly (it varies slowly with V_i).
     """
+    from .figures import draw_u_band
+
     vi = np.linspace(float(budget.vi_kt[0]), float(budget.vi_kt[-1]), 200)
     dv = np.asarray(result.delta_v_kt(vi)[0], dtype=float) * np.ones_like(vi)
-    u = np.interp(vi, budget.vi_kt, budget.expanded_kt)
-    ax.fill_between(vi, dv - u, dv + u, facecolor="none", edgecolor="tab:orange", hatch="//",
-                    lw=0.0, alpha=0.7, label=f"U (k = {COVERAGE_K:g}): statistical + Type B")
-    for sign in (-1, 1):
-        ax.plot(vi, dv + sign * u, color="tab:orange", lw=1.2)
-    ax.legend(fontsize=8, loc="best")
+    draw_u_band(ax, vi, dv, np.interp(vi, budget.vi_kt, budget.expanded_kt))
     return ax

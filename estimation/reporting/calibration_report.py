@@ -123,7 +123,7 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         if "points" not in result:      # a legs result is another method: not comparable
             warnings += _reproduces(result, ident)
         figures.append(("Calibration (paper Figs. 7-8 style), with the residual time history",
-                        _png(figs.calibration_png(ident))))
+                        _png(figs.calibration_png(ident, result))))
         figures.append(("Ground track and residual distribution", _png(figs.track_png(flight,
                                                                                       ident))))
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
@@ -133,14 +133,14 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         "method": _method(result),
         "correction_rows": [_correction_row(r) for r in rows],
         "has_u": has_u,
-        "budget": result.get("uncertainty_budget") or [],
+        "budget": _budget(result, rows),
         "altimeter_rows": [r for r in rows if r.get("dh_ft") is not None],
         "mach_rows": _mach_rows(result),
         "figures": figures,
         "warnings": warnings,
         "compliance": block,
         "legs": _legs(result),
-        "provenance": {"version": __version__, "date": now, "options": dict(options or {}),
+        "provenance": {"version": __version__, "date": now, "options": _option_rows(options),
                        "inputs": [(role, str(p), sha256(p)) for role, p in inputs]},
         "fmt": _fmt,
     }
@@ -186,13 +186,15 @@ def _conditions(result, flight):
         t = flight.time_s
         rows.append(("Flight time", f"{t[-1] - t[0]:.0f} s ({t[0]:.1f}–{t[-1]:.1f} s)"))
         if flight.alt_m is not None and (alt := flight.alt_m[~_isnan(flight.alt_m)]).size:
-            rows.append(("Altitude", f"{m_to_ft(alt.min()):.0f}–{m_to_ft(alt.max()):.0f} ft"))
-        rho = flight.rho_kgm3
-        rows.append(("Air density", f"{rho.min():.4f}–{rho.max():.4f} kg/m³"))
+            lo, hi = f"{m_to_ft(alt.min()):.0f}", f"{m_to_ft(alt.max()):.0f}"
+            rows.append(("Altitude (GPS)", f"{lo} ft" if lo == hi else f"{lo}–{hi} ft"))
+        lo, hi = f"{flight.rho_kgm3.min():.4f}", f"{flight.rho_kgm3.max():.4f}"
+        rows.append(("Air density", f"{lo} kg/m³" if lo == hi else f"{lo}–{hi} kg/m³"))
         for key in ("oat_source", "temperature_source", "autopilot", "firmware"):
             if key in flight.meta:
                 rows.append((key.replace("_", " ").capitalize(), str(flight.meta[key])))
-    rows.append(("Result source", str(result.get("source", "—"))))
+    if result.get("source"):
+        rows.append(("Result source", str(result["source"])))
     return rows
 
 
@@ -260,6 +262,46 @@ def _method(result):
                         "2σ: statistical, corrected for coloured residuals (no budget in the "
                         "result: systematic contributions not included)"),
     ]
+
+
+def _option_rows(options):
+    """(name, text) of the options given, as a person reads them: unset ones (None, False,
+    empty) left out, True as "yes", sequences space-separated, numbers in %g."""
+    def text(v):
+        if v is True:
+            return "yes"
+        if isinstance(v, (list, tuple)):
+            return " ".join(text(x) for x in v)
+        return format(v, "g") if isinstance(v, float) else str(v)
+
+    return [(k.replace("_", " "), text(v)) for k, v in sorted((options or {}).items())
+            if v is not None and v is not False and v != () and v != [] and v != ""]
+
+
+def _budget(result, rows):
+    """The budget tables: `sources` [{label, input, u_max, vi_at_max}] and, when the rows carry
+    each source per speed (`u_dv_by_source_kt`), `heads` and `by_speed` [{vi, u: [...], uc,
+    U}] in `uncertainty_budget` order."""
+    from .budget_tables import SOURCE_LABELS, source_label
+
+    entries = [b for b in result.get("uncertainty_budget") or [] if isinstance(b, dict)]
+    names = [b.get("source", "") for b in entries]
+    per = [r for r in rows if isinstance(r.get("u_dv_by_source_kt"), dict)]
+    per = per if per and len(per) == len(rows) else []
+    sources = []
+    for b in entries:
+        u_in, unit = b.get("u_input"), b.get("unit", "")
+        given = ("—" if u_in is None else f"{100 * u_in:.3g} % of reading" if unit == "1"
+                 else f"{u_in:.3g} {unit}".strip())
+        at = None
+        if per and (b.get("u_dv_kt") or 0.0) >= 5e-4:        # a zero term has no largest
+            at = max(per, key=lambda r: r["u_dv_by_source_kt"].get(b["source"], -1.0))["vi_kt"]
+        sources.append({"label": source_label(b.get("source", "")), "input": given,
+                        "u_max": b.get("u_dv_kt"), "vi_at_max": at})
+    by_speed = [{"vi": r["vi_kt"], "u": [r["u_dv_by_source_kt"].get(n) for n in names],
+                 "U": r.get("dv_U_kt")} for r in per]
+    heads = [SOURCE_LABELS.get(n, (n, n))[1] for n in names]
+    return {"sources": sources, "heads": heads, "by_speed": by_speed}
 
 
 def _correction_row(r):
