@@ -178,9 +178,14 @@ def _wall(cmd, cwd, runs=3):
     return statistics.median(times)
 
 
+def _machine():
+    """The cores and the load the times were measured under (other work slows them)."""
+    return f"{os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}"
+
+
 def demo_time(tmp):
     s = _wall([sys.executable, "-m", "pitotcal", "demo", "--out", str(tmp / "demo")], tmp)
-    return f"~{s:.0f} s"
+    return f"~{s:.0f} s on {_machine()}"
 
 
 def identify_time(tmp):
@@ -190,12 +195,13 @@ def identify_time(tmp):
          "compressible")
     cmd = [sys.executable, "-m", "pitotcal", "identify", str(tmp / "f320.csv")]
     full, bare = _wall(cmd, tmp), _wall([*cmd, "--no-budget"], tmp)
-    return f"{full:.1f} s end to end on 16,001 samples ({bare:.2f} s with `--no-budget`)"
+    return (f"{full:.1f} s end to end on 16,001 samples ({bare:.2f} s with `--no-budget`; "
+            f"{_machine()})")
 
 
 def tests_time(_):
     s = _wall([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"], ROOT, runs=1)
-    return f"about {10 * round(s / 10):.0f} s on 2 cores"
+    return f"about {10 * round(s / 10):.0f} s on {_machine()}"
 
 
 # name -> (kind, generator); kinds beyond "fixed" run only when asked
