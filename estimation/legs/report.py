@@ -133,8 +133,9 @@ def plot_legs(points, fit, path, series=None):
         vi = np.linspace(lo, hi, 200)
         dv, half = fit.delta_v_kt(vi)
         name = "global fit" if series is None else "global fit over the legs"
+        two_sigma = fit.noise_source in ("stated", "samples")
         ax.fill_between(vi, dv - half, dv + half, color="C0", alpha=0.25,
-                        label=f"{name} ({fit.model}) ±2σ" if fit.noise_source in ("stated", "samples")
+                        label=f"{name} ({fit.model}) ±2σ" if two_sigma
                         else f"{name} ({fit.model}), 95 % band")
         ax.plot(vi, dv, color="C0", lw=2)
     if series is not None:

@@ -102,12 +102,14 @@ def run(args):
     print(plan.summary())
     s = plan.settings
     if s.get("design") == "optimal":
+        met = s.get("target_2sigma_kt") is not None and \
+            s["predicted_dv_2sigma_kt"] <= s["target_2sigma_kt"]
         print(f"  design: dwells {s['dwell_order']} (low, check, high), {s['low_share']:.0%} of "
               f"the end-level time low; predicted {s['criterion']} 2σ of ΔV "
-              f"{s['predicted_dv_2sigma_kt']:.3g} kt in {s['turbulence_mps']:g} m/s turbulence"
+              f"{s['predicted_dv_2sigma_kt']:.2f} kt in {s['turbulence_mps']:g} m/s turbulence"
               + ("" if s.get("target_2sigma_kt") is None else
                  f" (target {s['target_2sigma_kt']:g} kt: "
-                 f"{'met' if s['predicted_dv_2sigma_kt'] <= s['target_2sigma_kt'] else 'NOT met'})"))
+                 f"{'met' if met else 'NOT met'})"))
     for kind, path in paths.items():
         print(f"  {kind:12s} {path}")
     sys.stdout.flush()
