@@ -26,3 +26,12 @@ def test_a_missed_target_is_said_with_a_duration(monkeypatch):
                                          r"3\d\d s without the target should meet it"):
         plan = plan_maneuver(design="optimal", design_options={"target_2sigma_kt": 0.6})
     assert plan.settings["predicted_dv_2sigma_kt"] > 0.6
+
+
+def test_the_cli_says_the_target_is_met(tmp_path, capsys):
+    from pitotcal.cli import main
+
+    assert main(["plan", "--design", "optimal", "--target-2sigma-kt", "0.6", "--no-figures",
+                 "-o", str(tmp_path / "p.csv")]) == 0
+    captured = capsys.readouterr()
+    assert "(target 0.6 kt: met)" in captured.out and "not met" not in captured.err
