@@ -1,11 +1,13 @@
 """pitotcal.maneuvers: planning a calibration maneuver and flying it in simulation.
 
 Planning: `profiles` (the q(t) schedules), `ocp` (the lateral-path optimal-control problem),
-`planner` (`plan_maneuver`), `outputs` (plan CSV companions: pilot card, setpoints, figure),
+`request` (`PlanRequest`, what to plan), `planner` (`plan_maneuver(PlanRequest(...))`),
+`outputs` (plan CSV companions: pilot card, setpoints, figure),
 `missions` (the plan as an autopilot mission: loiter circles and speed changes), `design`
 (information-optimal speed schedules, `plan_maneuver(design="optimal")`), `card` (pilot-card
 parts and picture).
-Flying: `simulator` (`simulate`), `autopilot` (guidance, auto-throttle, the stepping loop),
+Flying: `simulator` (`simulate(plan, SimulationOptions(...))`; `options.engine` picks pitotcal's
+point-mass model or JSBSim's), `autopilot` (guidance, auto-throttle, the stepping loop),
 `autothrottle` (the PI speed loop and its check), `turbulence`, `sensors`, `truth`.
 
 The names below load their module on first use, so that `pitotcal plan` does not import the
@@ -29,9 +31,13 @@ _EXPORTS = {
     "export_mission": ".plan.missions",
     "loiter_plan": ".plan.missions",
     "plan_maneuver": ".plan.planner",
+    "PlanRequest": ".plan.request",
     "DesignOptions": ".plan.design_request",
     "predict_plan_band_kt": ".plan.design",
     "simulate": ".fly.simulator",
+    "simulate_jsbsim": ".fly.simulator",
+    "SimulationOptions": ".fly.options",
+    "AirSensors": ".fly.options",
     "Fault": ".fly.faults",
     "apply_fault": ".fly.faults",
     "parse_fault": ".fly.faults",

@@ -10,6 +10,7 @@ from pitotcal.core import checks
 from pitotcal.core.airdata import AIR_DATA_MODES
 from pitotcal.core.errors import FlightDataError, ObservabilityError, PitotcalError
 from pitotcal.core.models import MODELS, get_model
+from pitotcal.core.scenario import GPS_NOISE_MAX_MPS
 
 from ..robustness import consistency, gates
 from .oe import OutputErrorProblem
@@ -113,7 +114,8 @@ def _identify(flight, model, air, gps_noise_std_mps, ipopt_options, gps_error, *
     """`identify` (`bounds` True) or `estimate` (False)."""
     checks.choice("model", model, (*MODELS, "auto"))
     if gps_noise_std_mps is not None:
-        gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0)
+        gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0,
+                                          GPS_NOISE_MAX_MPS)
     ipopt_options = checks.option_dict("ipopt_options", ipopt_options)
     checks.choice("air", air, AIR_DATA_MODES)
     gps_error = _gps_error(*gps_error, flight)

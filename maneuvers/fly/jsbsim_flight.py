@@ -1,12 +1,13 @@
-"""`simulate_jsbsim`: a plan flown by JSBSim (`maneuvers.fly.jsbsim_engine`), recorded by pitotcal's
-sensor models into the same Flight and Truth as `maneuvers.fly.simulator.simulate`."""
+"""`fly_jsbsim`: a plan flown by JSBSim (`maneuvers.fly.jsbsim_engine`), recorded by pitotcal's
+sensor models into the same Flight as `maneuvers.fly.simulator.simulate`, which makes the Truth
+(`simulate(plan, engine="jsbsim")`, or `simulate_jsbsim`)."""
 
 import math
 import tempfile
+from typing import NamedTuple
 
 import numpy as np
 
-from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model
 
 from .jsbsim_engine import (
@@ -20,50 +21,32 @@ from .jsbsim_engine import (
     start,
 )
 
-__all__ = ["simulate_jsbsim"]
+__all__ = ["JSBSimFlight", "fly_jsbsim"]
 
 
-def simulate_jsbsim(plan, *, seed=0, aircraft=DEFAULT_AIRCRAFT, center_deg=None, limits=None,
-                    keep_history=False, **options):
-    """Fly `plan` with JSBSim and record what the sensors would log (see the module notes).
+class JSBSimFlight(NamedTuple):
+    """What `fly_jsbsim` gives the simulator to make the Truth of: the sensors' Flight, the
+    states at the samples (the own engine's columns), the index of the plan's path point each
+    was guided to, the guidance's gains, the history (or None) and the truth's options."""
 
-    Parameters
-    ----------
-    plan : pitotcal.core.plan.Plan
-    seed : int
-        Seed of the turbulence (JSBSim's own generator), the transducer and the GPS noise.
-    aircraft : str
-        A JSBSim aircraft (`aircraft_names()`); default the Cessna 172 `c172x`.
-    center_deg : (float, float), optional
-        Where the test area's centre is on the earth; default the plan's `center_lat_deg`,
-        `center_lon_deg` settings, else `DEFAULT_CENTER_DEG`.
-    limits : pitotcal.core.dynamics.Limits, optional
-        Bank and roll-rate limits of the guidance (default: the plan's bank_max_deg).
-    **options
-        The sensor, wind and turbulence options of `maneuvers.fly.simulator.simulate` (same names,
-        same checks). `air_data` is ignored: JSBSim's own (isentropic) total pressure is used.
+    flight: object
+    states: np.ndarray
+    path_index: np.ndarray
+    speed_loop: dict
+    history: dict | None
+    options: dict
 
-    Returns
-    -------
-    (Flight, Truth)
-        As `maneuvers.fly.simulator.simulate`; the truth's `air_data` is "compressible", its
-        options add `engine`, `aircraft` and the Milspec settings with the sigma they make.
-    """
-    from pitotcal.core.checks import integer
 
-    from .options import check_plan, sim_options
-    from .simulator import default_limits, references
-
-    check_plan(plan)
-    options.pop("air_data", None)
-    opts = sim_options(plan, **_sim_option_args(options))
-    seed = integer("seed", seed, 0)
+def fly_jsbsim(plan, opts, seed, refs, limits):
+    """The JSBSim engine of `simulate`: `opts` the SimulationOptions resolved for the checked
+    `plan` (engine "jsbsim"), `seed` a checked integer, `refs` the plan on the dynamics grid,
+    `limits` the guidance's; a `JSBSimFlight`."""
+    aircraft = opts.aircraft or DEFAULT_AIRCRAFT
     settings = plan.settings or {}
-    limits = default_limits(plan) if limits is None else limits
+    center_deg = opts.center_deg
     if center_deg is None:
         center_deg = (settings.get("center_lat_deg", DEFAULT_CENTER_DEG[0]),
                       settings.get("center_lon_deg", DEFAULT_CENTER_DEG[1]))
-    refs = references(plan, opts.rate_hz)
     steps = max(1, math.ceil(JSBSIM_RATE_HZ * refs.dt_s - 1e-9))
     # the ground 300 m below the lowest point of the plan (Milspec wants a height above it),
     # as the own simulator takes the altitude as the height above ground
@@ -74,35 +57,16 @@ def simulate_jsbsim(plan, *, seed=0, aircraft=DEFAULT_AIRCRAFT, center_deg=None,
         sigma = set_turbulence(fdm, opts, alt_agl_m, seed)
         record, path_index = fly(fdm, refs, limits, opts, trim, center_deg, steps)
         del fdm                             # closes its output file before the folder goes
-    return _outputs(plan, refs, opts, seed, record, path_index,
+    return _outputs(refs, opts, seed, record, path_index,
                     {"engine": "jsbsim", "aircraft": aircraft, "milspec_sigma_mps": sigma,
-                     "center_deg": list(center_deg)}, keep_history)
+                     "center_deg": list(center_deg)})
 
 
-def _sim_option_args(options):
-    """`sim_options`'s arguments: the given options, `simulate`'s defaults for the others."""
-    import inspect
-
-    from .options import sim_options
-    from .simulator import simulate
-
-    defaults = inspect.signature(simulate).parameters
-    names = [n for n in inspect.signature(sim_options).parameters if n != "plan"]
-    unknown = set(options) - set(names)
-    if unknown:
-        raise TypeError(f"simulate_jsbsim() got unexpected options {sorted(unknown)}")
-    if options.get("turbulence_length_m") is not None:
-        raise PitotcalError("turbulence_length_m: JSBSim's Milspec turbulence sets its own "
-                            "scale lengths (MIL-F-8785C)", param="turbulence_length_m")
-    return {n: options.get(n, defaults[n].default) for n in names if n in defaults}
-
-
-def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
-    """The sensors' records of JSBSim's flight (Flight) and the Truth."""
+def _outputs(refs, opts, seed, record, path_index, engine):
+    """The sensors' records of JSBSim's flight, as a `JSBSimFlight`."""
     from pitotcal.core.flight import Flight
 
     from .sensors import gps_velocity_sensor, impact_pressure_sensor, static_port_pa
-    from .simulator import _tracking, _truth
 
     rng_qc, rng_gps = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)[1:])
     t, dt = refs.sample_time_s, 1.0 / opts.rate_hz
@@ -125,15 +89,13 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
                     oat_k=record["oat_k"],
                     source=f"simulate(engine=jsbsim, seed={seed})", meta=meta)
     states = np.column_stack([record[key] for key in _STATES])
-    tracking = _tracking(plan, refs, states, path_index, record["rho_kgm3"])
     realised = {"turbulence_rms_mps": _turbulence_rms(record),
                 "max_sideslip_deg": float(np.degrees(np.max(np.abs(record["beta_rad"])))),
                 "max_alpha_deg": float(np.degrees(np.max(record["alpha_rad"]))),
                 "stall_warning_s": float(np.sum(record["stall_warning"] > 0) * dt)}
-    truth = _truth(plan, opts, seed, states, tracking, {"gains": dict(GAINS)},
-                   dict(record, time_s=t) if keep_history else None,
-                   options={**opts.to_dict(), **engine, **realised}, air_data="compressible")
-    return flight, truth
+    return JSBSimFlight(flight, states, path_index, {"gains": dict(GAINS)},
+                        dict(record, time_s=t) if opts.keep_history else None,
+                        {**opts.to_dict(), **engine, **realised})
 
 
 # The own simulator's state columns (maneuvers.fly.guidance.fly), from the record.

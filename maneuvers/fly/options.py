@@ -1,28 +1,28 @@
-"""The options of `simulate` (maneuvers.fly.simulator), checked before any work.
+"""The options of `simulate` (maneuvers.fly.simulator): `SimulationOptions`, checked before any
+work.
 
-Every number goes through pitotcal.core.checks, so an error names the parameter (and the
-command line its flag); the mean wind defaults to the plan's settings; the record's size is
-checked against MAX_SAMPLES and the GPS latency against the plan's length.
+Every field is checked when the object is made, through pitotcal.core.checks, so an error names
+the field (and the command line its flag); `SimulationOptions.resolved` fills in the mean wind
+from the plan's settings and checks the record's size against MAX_SAMPLES, the GPS latency
+against the plan's length and the pressure error over its q_c.
 """
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
 from pitotcal.core.airdata import AIR_DATA_MODES
-from pitotcal.core.checks import choice, exact, number, positive, round_to_limit
+from pitotcal.core.checks import choice, number, positive
+from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.models import get_model
-from pitotcal.core.plan import Plan
-from pitotcal.core.scenario import T2_PLAN, true_k
+from pitotcal.core.geo import check_lat_lon
+from pitotcal.core.models import MODELS, get_model
+from pitotcal.core.scenario import GPS_NOISE_MAX_MPS, T2_PLAN, true_k
 
-__all__ = ["MAX_SAMPLES", "MIN_SAMPLES", "SIM_LIMITS", "AirSensors", "SimOptions", "air_sensors",
-           "check_plan", "sim_options"]
+from .flyable import MAX_SAMPLES, MIN_SAMPLES, check_plan, check_pressure_error, check_samples
 
-# Memory grows with the samples (~1.5 kB each in the scalar loop, measured: 1.5 GB peak and
-# 13 s for 10^6): 500,000 is 2.8 h at 50 Hz, or 42 min at 200 Hz.
-MAX_SAMPLES = 500_000
-MIN_SAMPLES = 10          # the flight CSV reader's MIN_ROWS: fewer is no flight
+__all__ = ["ENGINES", "ENGINE_AIR_DATA", "MAX_SAMPLES", "MIN_SAMPLES", "SIM_LIMITS", "AirSensors",
+           "SimOptions", "SimulationOptions", "air_sensors", "check_plan", "simulation_options"]
 
 # Issue 15: upper bounds of the options, with the reason given when one is refused (the
 # simulator would run, overflow or fill memory beyond them; nothing real lies there).
@@ -38,7 +38,7 @@ SIM_LIMITS = {
     "qc_scale_error": (0.5, "a gain error beyond 50 % is a broken sensor"),
     "pneumatic_lag_s": (5.0, "pitot tubing lags 0.01-0.5 s; seconds is a blocked line"),
     "gps_rate_hz": (100.0, "GNSS receivers update at 1-50 Hz"),
-    "gps_noise_mps": (10.0, "receivers report 0.02-0.5 m/s RMS"),
+    "gps_noise_mps": (GPS_NOISE_MAX_MPS, "receivers report 0.02-0.5 m/s RMS"),
     "gps_gm_sigma_mps": (5.0, "a receiver's slowly drifting velocity error is cm/s to dm/s"),
 }
 
@@ -62,51 +62,147 @@ def _limited(name, value, lo=0.0, *, lo_open=False, key=None):
         raise
 
 
-_PLAN_COLUMNS_FLOWN = ("north_m", "east_m", "alt_m", "heading_deg", "bank_deg", "tas_mps",
-                       "cas_mps")
-
-
 @dataclass(frozen=True)
-class SimOptions:
-    """The checked options of one simulation (the `options` of its `Truth`), SI."""
+class SimulationOptions:
+    """The options of one simulation (`simulate(plan, options)`): each field checked when the
+    object is made, a `PitotcalError` naming the field (the command line shows its flag).
 
-    model: str
-    k: tuple
-    wind_speed_mps: float
-    wind_from_deg: float
-    wind_drift_mps2: tuple
-    turbulence_mps: float
-    turbulence_length_m: float | None
-    rate_hz: float
-    qc_noise_pa: float
-    qc_quantization_pa: float
-    qc_bias_pa: float
-    qc_scale_error: float
-    pneumatic_lag_s: float
-    gps_rate_hz: float
-    gps_noise_mps: float
-    gps_latency_s: float
-    air_data: str = "incompressible"
+    Fields left at None take their value from the plan or the model when the plan is flown
+    (`resolved`); the resolved options are the `options` of the flight's `Truth`.
+
+    Attributes
+    ----------
+    model : str
+        True pressure-error structure (pitotcal.core.models.MODELS); ``--model``.
+    k : sequence of float, dict or None
+        Its true coefficients (the first as many as the model has are used), or a dict of some
+        of them by name (``{"k2": -20.0}``; the others the model's defaults); None: all
+        `pitotcal.core.scenario.true_k(model)` (k1 = 0.02, k2 = -15 Pa for inverse); ``--k1``,
+        ``--k2``.
+    wind_speed_mps, wind_from_deg : float or None
+        Mean wind (FROM, deg true, in [0, 360)); None: the plan's settings (else calm).
+    wind_drift_mps2 : (float, float)
+        Linear drift of the air-mass velocity (north, east), m/s², about the record's middle;
+        ``--wind-drift-n-mps2``, ``--wind-drift-e-mps2``.
+    turbulence_mps, turbulence_length_m : float, float or None
+        RMS of the horizontal Dryden gusts, m/s (0: none); their scale length (None:
+        MIL-F-8785C's at the plan's altitude; own engine only).
+    rate_hz : float
+        Sample rate, Hz (the dynamics step at `DYNAMICS_RATE_HZ` or faster whatever it is).
+    qc_noise_pa, qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s : float
+        Impact-pressure transducer: white noise std (Pa), converter step (Pa), zero offset (Pa),
+        relative gain error, first-order tubing lag (s).
+    gps_rate_hz, gps_noise_mps, gps_latency_s : float
+        GPS velocity: update rate (Hz; 0 = every sample), white noise std per component and
+        update (m/s), age of the reported velocity (s).
+    air_data : {"incompressible", "compressible"} or None
+        True impact pressure: ½ρV_t² (the paper's eq. 2) or isentropic with the ISA p_s and T;
+        None: the engine's own (incompressible for "own", compressible for "jsbsim", the only
+        one JSBSim has).
+    air_sensors : AirSensors, dict or None
+        Temperature, humidity, probe-arm and GPS-bias effects (own engine only).
+    gps_gm_sigma_mps, gps_gm_tau_s : float
+        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s).
+    vertical_gusts : bool
+        Fly Dryden's vertical gust too (recorded as flown: False without turbulence).
+    engine : {"own", "jsbsim"}
+        pitotcal's point-mass model, or JSBSim's six-degree-of-freedom one
+        (maneuvers.fly.jsbsim_flight); ``--engine``.
+    aircraft : str or None
+        JSBSim aircraft (None: c172x); engine "jsbsim" only; ``--aircraft``.
+    center_deg : (float, float) or None
+        Where JSBSim flies the test area (lat, lon; None: the plan's centre, else a default);
+        engine "jsbsim" only.
+    limits : pitotcal.core.dynamics.Limits or None
+        Guidance limits (None: Limits with the plan's bank_max_deg).
+    speed_loop : maneuvers.plan.autothrottle.SpeedLoop or None
+        Own engine's auto-throttle (None: tuned at the plan's mid-range true airspeed).
+    keep_history : bool
+        Also keep the true time histories in ``truth.history`` (not written to the truth JSON).
+    """
+
+    model: str = "inverse"
+    k: tuple | dict | None = None
+    wind_speed_mps: float | None = None
+    wind_from_deg: float | None = None
+    wind_drift_mps2: tuple = (0.0, 0.0)
+    turbulence_mps: float = 0.5
+    turbulence_length_m: float | None = None
+    rate_hz: float = 50.0
+    qc_noise_pa: float = 0.5
+    qc_quantization_pa: float = 0.0
+    qc_bias_pa: float = 0.0
+    qc_scale_error: float = 0.0
+    pneumatic_lag_s: float = 0.0
+    gps_rate_hz: float = 5.0
+    gps_noise_mps: float = 0.05
+    gps_latency_s: float = 0.0
+    air_data: str | None = None
     air_sensors: "AirSensors | None" = None
-    # Gauss-Markov GPS velocity error (issue 11): steady-state sigma (m/s; 0 none), tau (s)
     gps_gm_sigma_mps: float = 0.0
     gps_gm_tau_s: float = 30.0
-    # Dryden's vertical gust flown (issue 11): plunge, altitude, GPS climb and V_t
     vertical_gusts: bool = False
+    engine: str = "own"
+    aircraft: str | None = None
+    center_deg: tuple | None = None
+    limits: object = None
+    speed_loop: object = None
+    keep_history: bool = False
+
+    def __post_init__(self):
+        for name, value in _checked_fields(self).items():
+            object.__setattr__(self, name, value)
+
+    def resolved(self, plan):
+        """These options for flying `plan`: the wind from its settings, the coefficients and
+        air data filled in, the sizes checked against it (the record's samples, the GPS
+        latency, the pressure error over its q_c)."""
+        settings = plan.settings or {}
+        opts = replace(
+            self,
+            k=_true_k(self.model, self.k),
+            wind_speed_mps=(settings.get("wind_speed_mps", 0.0) if self.wind_speed_mps is None
+                            else self.wind_speed_mps),
+            wind_from_deg=(settings.get("wind_from_deg", T2_PLAN["wind_from_deg"])
+                           if self.wind_from_deg is None else self.wind_from_deg),
+            air_data=self.air_data or ENGINE_AIR_DATA[self.engine],
+            vertical_gusts=self.vertical_gusts and self.turbulence_mps > 0)
+        span_s = float(plan.time_s[-1] - plan.time_s[0])
+        check_samples(opts.rate_hz, span_s)
+        check_pressure_error(opts, plan)
+        if opts.gps_latency_s >= span_s:
+            raise PitotcalError(f"gps_latency_s {opts.gps_latency_s:g} must be shorter than the "
+                                f"plan's {span_s:g} s (typical receivers: 0-0.5 s)",
+                                param="gps_latency_s")
+        return opts
 
     def to_dict(self):
-        """As written in the truth JSON (sequences as lists; `air_sensors` only when set)."""
-        out = asdict(self)
+        """As written in the truth JSON, of resolved options (sequences as lists; the engine's
+        and the run's own fields left to the engine; `air_sensors`, the Gauss-Markov error and
+        vertical gusts only when set, so the default's truth JSON keeps its keys)."""
+        out = {f.name: getattr(self, f.name) for f in fields(self) if f.name not in _RUN_FIELDS}
         out["k"], out["wind_drift_mps2"] = list(self.k), list(self.wind_drift_mps2)
         if self.air_sensors is None:
-            del out["air_sensors"]                 # the default's truth JSON stays as it was
+            del out["air_sensors"]
         else:
-            out["air_sensors"]["gps_bias_mps"] = list(self.air_sensors.gps_bias_mps)
-        if not self.gps_gm_sigma_mps:       # without it, the truth JSON stays as it was
+            out["air_sensors"] = {**asdict(self.air_sensors),
+                                  "gps_bias_mps": list(self.air_sensors.gps_bias_mps)}
+        if not self.gps_gm_sigma_mps:
             del out["gps_gm_sigma_mps"], out["gps_gm_tau_s"]
-        if not self.vertical_gusts:         # likewise
+        if not self.vertical_gusts:
             del out["vertical_gusts"]
         return out
+
+
+# The name the simulator's internals and older code use for the same object.
+SimOptions = SimulationOptions
+
+ENGINES = ("own", "jsbsim")
+# The true impact pressure each engine flies when `air_data` is None.
+ENGINE_AIR_DATA = {"own": "incompressible", "jsbsim": "compressible"}
+# Fields that say how to run, not what the sensors record: not in the truth's `options`
+# (the JSBSim engine adds `engine`, `aircraft` and `center_deg` itself).
+_RUN_FIELDS = ("engine", "aircraft", "center_deg", "limits", "speed_loop", "keep_history")
 
 
 @dataclass(frozen=True)
@@ -165,122 +261,135 @@ def _checked_air_sensors(value):
     return air_sensors(**value)
 
 
-def check_plan(plan):
-    """A `Plan` the simulator can fly: >= 2 rows, time increasing, finite, airspeeds > 0."""
-    if not isinstance(plan, Plan):
-        raise PitotcalError(f"plan must be a pitotcal.core.plan.Plan (pitotcal.read_plan reads "
-                            f"one), got {type(plan).__name__}")
-    if plan.n < 2 or not np.all(np.diff(plan.time_s) > 0):
-        raise PitotcalError("plan must have >= 2 rows with strictly increasing time_s")
-    for name in _PLAN_COLUMNS_FLOWN:
-        if not np.all(np.isfinite(plan.column(name))):
-            raise PitotcalError(f"plan column {name} has a non-finite value")
-    if np.any(plan.tas_mps <= 0) or np.any(plan.cas_mps <= 0):
-        raise PitotcalError("plan airspeeds must be > 0")
+def _checked_fields(o):
+    """{field: checked value} of `SimulationOptions` `o` (PitotcalError naming the field)."""
+    choice("model", o.model, tuple(MODELS))
+    if not isinstance(o.wind_drift_mps2, (tuple, list, np.ndarray)) or len(o.wind_drift_mps2) != 2:
+        raise PitotcalError(f"wind_drift_mps2 must be (north, east), got {o.wind_drift_mps2!r}",
+                            param="wind_drift_mps2")
+    out = dict(
+        k=_checked_k(o.model, o.k),
+        wind_speed_mps=(None if o.wind_speed_mps is None
+                        else _limited("wind_speed_mps", o.wind_speed_mps)),
+        wind_from_deg=(None if o.wind_from_deg is None
+                       else number("wind_from_deg", o.wind_from_deg, 0.0, 360.0, hi_open=True)),
+        # each component named like its command-line flag
+        wind_drift_mps2=tuple(_limited(f"wind_drift_{axis}_mps2", v, None, key="wind_drift_mps2")
+                              for axis, v in zip("ne", o.wind_drift_mps2)),
+        turbulence_mps=_limited("turbulence_mps", o.turbulence_mps),
+        turbulence_length_m=(None if o.turbulence_length_m is None
+                             else _limited("turbulence_length_m", o.turbulence_length_m,
+                                           lo_open=True)),
+        rate_hz=number("rate_hz", o.rate_hz, 0.0, lo_open=True),   # bounded by MAX_SAMPLES
+        qc_noise_pa=_limited("qc_noise_pa", o.qc_noise_pa),
+        qc_quantization_pa=_limited("qc_quantization_pa", o.qc_quantization_pa),
+        qc_bias_pa=_limited("qc_bias_pa", o.qc_bias_pa, None),
+        qc_scale_error=_limited("qc_scale_error", o.qc_scale_error, -0.5),
+        pneumatic_lag_s=_limited("pneumatic_lag_s", o.pneumatic_lag_s),
+        gps_rate_hz=_limited("gps_rate_hz", o.gps_rate_hz or 0.0),
+        gps_noise_mps=_limited("gps_noise_mps", o.gps_noise_mps),
+        gps_latency_s=number("gps_latency_s", o.gps_latency_s, 0.0),   # bounded by the plan
+        air_data=None if o.air_data is None else choice("air_data", o.air_data, AIR_DATA_MODES),
+        air_sensors=_checked_air_sensors(o.air_sensors),
+        gps_gm_sigma_mps=_limited("gps_gm_sigma_mps", o.gps_gm_sigma_mps),
+        gps_gm_tau_s=positive("gps_gm_tau_s", o.gps_gm_tau_s),
+        vertical_gusts=_flag("vertical_gusts", o.vertical_gusts),
+        keep_history=_flag("keep_history", o.keep_history),
+        limits=_instance("limits", o.limits, Limits, "pitotcal.core.dynamics.Limits"))
+    if o.speed_loop is not None:
+        from ..plan.autothrottle import SpeedLoop
+
+        _instance("speed_loop", o.speed_loop, SpeedLoop, "maneuvers.plan.autothrottle.SpeedLoop")
+    out.update(_checked_engine(o, out))
+    return out
 
 
-# Issue 15: the largest pressure error simulated, |dp/q_c| (beyond it the sensor would read
-# zero or negative impact pressure: no pitot-static system).
-MAX_PRESSURE_ERROR = 0.5
-
-
-def _check_pressure_error(opts, plan):
-    """The true coefficients keep |dp/q_c| <= MAX_PRESSURE_ERROR over the plan's q_c."""
-    model = get_model(opts.model)
-    qc = np.asarray(plan.qc_pa, dtype=float)
-    qc = qc[np.isfinite(qc) & (qc > 0)]
-    with np.errstate(all="ignore"):
-        ratio = np.asarray(model(opts.k, qc), dtype=float)
-    worst = float(np.max(np.abs(ratio))) if ratio.size else 0.0
-    if not worst <= MAX_PRESSURE_ERROR:
-        names = ", ".join(f"{n} {v:g}" for n, v in zip(model.params, opts.k))
+def _checked_engine(o, checked):
+    """The engine's fields, and what only the own engine flies refused with JSBSim."""
+    engine = choice("engine", o.engine, ENGINES)
+    if engine == "own":
+        if o.aircraft is not None:
+            raise PitotcalError("aircraft: only engine jsbsim flies a six-degree-of-freedom "
+                                "model", param="aircraft", mentions=("engine",))
+        if o.center_deg is not None:
+            raise PitotcalError("center_deg: only engine jsbsim places the flight on the earth",
+                                param="center_deg", mentions=("engine",))
+        return {"engine": engine}
+    if checked["air_data"] not in (None, "compressible"):
+        raise PitotcalError(f"air_data {checked['air_data']}: JSBSim's impact pressure is its "
+                            "own isentropic total pressure minus static (compressible)",
+                            param="air_data")
+    if checked["turbulence_length_m"] is not None:
+        raise PitotcalError("turbulence_length_m: JSBSim's Milspec turbulence sets its own "
+                            "scale lengths (MIL-F-8785C)", param="turbulence_length_m")
+    if checked["air_sensors"] is not None:
         raise PitotcalError(
-            f"{names}: the {model.name} pressure error dp/qc reaches {worst:.3g} on the "
-            f"plan's q_c {qc.min():.0f}-{qc.max():.0f} Pa; at most {MAX_PRESSURE_ERROR:g} "
-            "(beyond it the sensor reads no impact pressure)", param=model.params[0],
-            mentions=model.params[1:])
+            "the air-data sensors (tat_recovery, rh_percent, probe_arm_m, oat_bias_k, "
+            "gps_bias_mps) apply to engine own only", param="air_sensors",
+            mentions=("tat_recovery", "rh_percent", "probe_arm_m", "oat_bias_k", "gps_bias_mps",
+                      "engine"))
+    if o.aircraft is not None and not isinstance(o.aircraft, str):
+        raise PitotcalError(f"aircraft must be a JSBSim aircraft name, got {o.aircraft!r}",
+                            param="aircraft")
+    center = None
+    if o.center_deg is not None:
+        if len(o.center_deg) != 2:
+            raise PitotcalError(f"center_deg must be (lat, lon), got {o.center_deg!r}",
+                                param="center_deg")
+        center = check_lat_lon(*o.center_deg)
+    return {"engine": engine, "center_deg": center}
 
 
-def _check_samples(rate_hz, span_s):
-    """At least `MIN_SAMPLES` and at most `MAX_SAMPLES` over the plan; the rate suggested is
-    computed from those limits and passes them."""
-    samples = span_s * rate_hz + 1
-    if MIN_SAMPLES <= samples <= MAX_SAMPLES:
-        return
-    lo = round_to_limit((MIN_SAMPLES - 1) / span_s, lo=True)
-    hi = (MAX_SAMPLES - 1) / span_s
-    hi = float(np.floor(hi)) if hi >= 100 else round_to_limit(hi, lo=False)
-    if samples > MAX_SAMPLES:
-        raise PitotcalError(
-            f"rate_hz {exact(rate_hz)} gives {samples:.3g} samples over the plan's {span_s:g} "
-            f"s; the simulator records at most {MAX_SAMPLES:,}: use at most {exact(hi)} Hz",
-            param="rate_hz")
-    raise PitotcalError(
-        f"rate_hz {exact(rate_hz)} gives {samples:.3g} samples over the plan's {span_s:g} s; "
-        f"a flight needs at least {MIN_SAMPLES}: use at least {exact(lo)} Hz", param="rate_hz")
+def _instance(name, value, cls, shown):
+    """None or an instance of `cls` (PitotcalError naming `name` and the class otherwise)."""
+    if value is not None and not isinstance(value, cls):
+        raise PitotcalError(f"{name} must be a {shown} or None, got {type(value).__name__}",
+                            param=name)
+    return value
 
 
-def _true_k(model, k):
-    pe_model = get_model(model)
+def _checked_k(model, k):
+    """None, a dict of some of the model's coefficients by name, or a tuple of >= as many
+    numbers as it has (each named k1, k2, ...)."""
+    names = get_model(model).params
     if k is None:
-        k = true_k(model)
+        return None
+    if isinstance(k, dict):
+        for name in k:
+            if name not in names:
+                raise PitotcalError(f"{name}: model {model!r} has only {len(names)} "
+                                    f"coefficient(s), {', '.join(names)}", param=str(name))
+        return {name: number(name, value) for name, value in k.items()}
     try:
         k = tuple(number(f"k{i + 1}", v) for i, v in enumerate(k))
     except TypeError:
         raise PitotcalError(f"k must be a sequence of numbers, got {k!r}", param="k") from None
-    if len(k) < len(pe_model.params):
-        raise PitotcalError(f"k needs {len(pe_model.params)} coefficients for model "
+    if len(k) < len(names):
+        raise PitotcalError(f"k needs {len(names)} coefficients for model "
                             f"{model!r}, got {len(k)}", param="k")
-    return k[:len(pe_model.params)]
+    return k
 
 
-def sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2, turbulence_mps,
-             turbulence_length_m, rate_hz, qc_noise_pa, qc_quantization_pa, qc_bias_pa,
-             qc_scale_error, pneumatic_lag_s, gps_rate_hz, gps_noise_mps, gps_latency_s,
-             air_data="incompressible", sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
-             vertical_gusts=False):
-    """`SimOptions` from `simulate`'s arguments (see there): each checked, naming the parameter,
-    the wind's defaults filled from the plan's settings, sizes checked against the plan."""
-    settings = plan.settings or {}
-    if wind_speed_mps is None:
-        wind_speed_mps = settings.get("wind_speed_mps", 0.0)
-    if wind_from_deg is None:
-        wind_from_deg = settings.get("wind_from_deg", T2_PLAN["wind_from_deg"])
-    if len(wind_drift_mps2) != 2:
-        raise PitotcalError(f"wind_drift_mps2 must be (north, east), got {wind_drift_mps2!r}",
-                            param="wind_drift_mps2")
-    opts = SimOptions(
-        model=model, k=_true_k(model, k),
-        wind_speed_mps=_limited("wind_speed_mps", wind_speed_mps),
-        wind_from_deg=number("wind_from_deg", wind_from_deg, 0.0, 360.0, hi_open=True),
-        # each component named like its command-line flag
-        wind_drift_mps2=tuple(_limited(f"wind_drift_{axis}_mps2", v, None,
-                                       key="wind_drift_mps2")
-                              for axis, v in zip("ne", wind_drift_mps2)),
-        turbulence_mps=_limited("turbulence_mps", turbulence_mps),
-        turbulence_length_m=(None if turbulence_length_m is None
-                             else _limited("turbulence_length_m", turbulence_length_m,
-                                           lo_open=True)),
-        rate_hz=number("rate_hz", rate_hz, 0.0, lo_open=True),   # bounded by MAX_SAMPLES
-        qc_noise_pa=_limited("qc_noise_pa", qc_noise_pa),
-        qc_quantization_pa=_limited("qc_quantization_pa", qc_quantization_pa),
-        qc_bias_pa=_limited("qc_bias_pa", qc_bias_pa, None),
-        qc_scale_error=_limited("qc_scale_error", qc_scale_error, -0.5),
-        pneumatic_lag_s=_limited("pneumatic_lag_s", pneumatic_lag_s),
-        gps_rate_hz=_limited("gps_rate_hz", gps_rate_hz or 0.0),
-        gps_noise_mps=_limited("gps_noise_mps", gps_noise_mps),
-        gps_latency_s=number("gps_latency_s", gps_latency_s, 0.0),   # bounded by the plan
-        air_data=choice("air_data", air_data, AIR_DATA_MODES),
-        air_sensors=_checked_air_sensors(sensors),
-        gps_gm_sigma_mps=_limited("gps_gm_sigma_mps", gps_gm_sigma_mps),
-        gps_gm_tau_s=positive("gps_gm_tau_s", gps_gm_tau_s),
-        # recorded as flown: no turbulence, no vertical gust (turbulence_mps checked above)
-        vertical_gusts=_flag("vertical_gusts", vertical_gusts) and float(turbulence_mps) > 0)
-    span_s = float(plan.time_s[-1] - plan.time_s[0])
-    _check_samples(opts.rate_hz, span_s)
-    _check_pressure_error(opts, plan)
-    if opts.gps_latency_s >= span_s:
-        raise PitotcalError(f"gps_latency_s {opts.gps_latency_s:g} must be shorter than the "
-                            f"plan's {span_s:g} s (typical receivers: 0-0.5 s)",
-                            param="gps_latency_s")
-    return opts
+def _true_k(model, k):
+    """The checked `k` of `model` as the tuple flown (None and a dict filled from the model's
+    defaults, a longer sequence cut to the model's coefficients)."""
+    names = get_model(model).params
+    if k is None or isinstance(k, dict):
+        given = k or {}
+        return tuple(given.get(name, default) for name, default in zip(names, true_k(model)))
+    return tuple(k[:len(names)])
+
+
+def simulation_options(options=None, overrides=None, *, caller="simulate"):
+    """`options` (a SimulationOptions, or None for the defaults) with `overrides` (a dict of
+    its fields) put in: the overrides win. An unknown name is a TypeError naming `caller`."""
+    overrides = overrides or {}
+    unknown = sorted(set(overrides) - {f.name for f in fields(SimulationOptions)})
+    if unknown:
+        raise TypeError(f"{caller}() got an unexpected keyword argument {unknown[0]!r}")
+    if options is None:
+        return SimulationOptions(**overrides)
+    if not isinstance(options, SimulationOptions):
+        raise PitotcalError(f"options must be a SimulationOptions or None, got "
+                            f"{type(options).__name__}", param="options")
+    return replace(options, **overrides) if overrides else options

@@ -2,7 +2,8 @@
 
 `simulate` runs five steps, each a function here or in a sibling module:
 
-1. options: every argument checked before any work (maneuvers.fly.options);
+1. options: every field checked before any work (maneuvers.fly.options.SimulationOptions),
+   then resolved against the plan; ``engine="jsbsim"`` hands the plan to JSBSim here;
 2. references: the plan on the dynamics grid, which steps at DYNAMICS_RATE_HZ or faster
    whatever the logging rate (`References`, `references`);
 3. wind field: the mean wind, a slow linear drift and Dryden turbulence (maneuvers.turbulence)
@@ -28,7 +29,7 @@ from .sensors import (
     impact_pressure_sensor,
     static_port_pa,
 )
-from .options import MAX_SAMPLES, SimOptions, check_plan, sim_options
+from .options import MAX_SAMPLES, SimOptions, SimulationOptions, check_plan, simulation_options
 from .truth import (
     Tracking,
     Truth,
@@ -61,9 +62,11 @@ __all__ = [
     "MAX_SAMPLES",
     "References",
     "SimOptions",
+    "SimulationOptions",
     "WindField",
     "references",
     "simulate",
+    "simulate_jsbsim",
     "tracking_warnings",
     "truth_path_for",
     "wind_field",
@@ -310,86 +313,82 @@ def _truth(plan, opts, seed, states, tracking, speed_loop, history, *, options=N
         air_data=opts.air_data if air_data is None else air_data)
 
 
-def simulate(plan, *, seed=0, model="inverse", k=None, wind_speed_mps=None, wind_from_deg=None,
-             wind_drift_mps2=(0.0, 0.0), turbulence_mps=0.5, turbulence_length_m=None,
-             rate_hz=50.0, qc_noise_pa=0.5, qc_quantization_pa=0.0, qc_bias_pa=0.0,
-             qc_scale_error=0.0, pneumatic_lag_s=0.0, gps_rate_hz=5.0, gps_noise_mps=0.05,
-             gps_latency_s=0.0, air_data="incompressible", limits=None, speed_loop=None,
-             keep_history=False, air_sensors=None, gps_gm_sigma_mps=0.0, gps_gm_tau_s=30.0,
-             vertical_gusts=False):
+def simulate(plan, options=None, *, seed=0, **overrides):
     """Fly `plan` in simulation and record what the sensors would log.
 
     Parameters
     ----------
     plan : pitotcal.core.plan.Plan
-        The maneuver; its `settings` give the mean wind unless overridden.
+        The maneuver; its `settings` give the mean wind unless the options say otherwise.
+    options : SimulationOptions, optional
+        What to fly and record (maneuvers.fly.options.SimulationOptions, every field checked
+        when it is made); None: its defaults.
     seed : int
         Seed of all randomness (turbulence, transducer noise, GPS noise: separate streams).
-    model : str
-        True pressure-error structure (pitotcal.core.models.MODELS).
-    k : sequence of float, optional
-        Its true coefficients (the first as many as the model has are used); default
-        `pitotcal.core.scenario.true_k(model)`: k1 = 0.02, k2 = -15 Pa for the inverse model.
-    wind_speed_mps, wind_from_deg : float, optional
-        Mean wind (FROM, deg true, in [0, 360)); default: the plan's settings (else calm).
-    wind_drift_mps2 : (float, float)
-        Linear drift of the air-mass velocity (north, east), m/s^2, about the record's middle:
-        wind(t) = mean + drift * (t - t_mid), so the process mean over the record is the mean.
-    turbulence_mps : float
-        RMS of the horizontal Dryden gusts sigma_u = sigma_v, m/s (0: none).
-    turbulence_length_m : float, optional
-        Horizontal scale length; default MIL-F-8785C low-altitude L_u at the plan's altitude.
-    rate_hz : float
-        Sample rate, Hz. The dynamics and the autopilot step a whole number of times per
-        sample, at DYNAMICS_RATE_HZ (50 Hz) or faster, so the flight does not depend on it.
-    qc_noise_pa, qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s :
-        Impact-pressure transducer: white noise std (Pa), converter step (Pa), zero offset (Pa),
-        relative gain error, first-order tubing lag (s).
-    gps_rate_hz, gps_noise_mps, gps_latency_s :
-        GPS velocity: update rate (Hz, sample-and-hold in between; 0 = every sample), white
-        noise std per component and update (m/s), age of the reported velocity (s).
-    air_data : {"incompressible", "compressible"}
-        True impact pressure: ½ρV_t² (the paper's eq. 2, the default) or isentropic with
-        the ISA p_s and T at the altitude flown (pitotcal.core.airdata); compressible flights
-        also carry `ps_pa` (the static port: p_s + q_c − q_ci) and `oat_k`.
-    gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts : float, float, bool
-        Gauss-Markov GPS velocity error on top of the white: std (m/s; 0 none), tau (s);
-        fly Dryden's vertical gust too (`_plunge`; False: as before).
-    limits : pitotcal.core.dynamics.Limits, optional
-        Default: Limits with the plan's bank_max_deg.
-    speed_loop : maneuvers.plan.autothrottle.SpeedLoop, optional
-        Default: tuned at the plan's mid-range true airspeed.
-    keep_history : bool
-        Also keep the true time histories in truth.history (not written to the truth JSON).
-    air_sensors : maneuvers.fly.options.AirSensors or dict, optional (issue 9; None: as before)
+    **overrides
+        Fields of `SimulationOptions` by name (``model="linear"``, ``turbulence_mps=0``,
+        ``engine="jsbsim"``, ...), put into `options`: with both, the overrides win. An
+        unknown name is a TypeError.
 
     Returns
     -------
     flight : pitotcal.core.flight.Flight
-        time_s, qci_pa, gps_vn/ve/vd_mps, rho_kgm3 (ISA at the altitude flown), alt_m.
+        time_s, qci_pa, gps_vn/ve/vd_mps, rho_kgm3 (ISA at the altitude flown), alt_m; with
+        compressible air data also ps_pa (the static port: p_s + q_c − q_ci) and oat_k.
     truth : maneuvers.fly.truth.Truth
         The true calibration and mean wind flown, the options, and the tracking errors.
+
+    Notes
+    -----
+    ``engine="jsbsim"`` flies the plan with JSBSim (maneuvers.fly.jsbsim_flight) and records it
+    with the same sensor models.
+
+    Example
+    -------
+    >>> from pitotcal.maneuvers import SimulationOptions, plan_maneuver, simulate
+    >>> calm = SimulationOptions(turbulence_mps=0.0, rate_hz=10.0)
+    >>> flight, truth = simulate(plan_maneuver(), calm, seed=1, model="linear")
+    >>> truth.model, flight.n
+    ('linear', 2401)
     """
+    opts = simulation_options(options, overrides)
     check_plan(plan)
-    opts = sim_options(plan, model, k, wind_speed_mps, wind_from_deg, wind_drift_mps2,
-                       turbulence_mps, turbulence_length_m, rate_hz, qc_noise_pa,
-                       qc_quantization_pa, qc_bias_pa, qc_scale_error, pneumatic_lag_s,
-                       gps_rate_hz, gps_noise_mps, gps_latency_s, air_data, air_sensors,
-                       gps_gm_sigma_mps, gps_gm_tau_s, vertical_gusts)
+    opts = opts.resolved(plan)
     seed = integer("seed", seed, 0)
-    limits = default_limits(plan) if limits is None else limits
+    limits = default_limits(plan) if opts.limits is None else opts.limits
+    refs = references(plan, opts.rate_hz)
+    if opts.engine == "jsbsim":
+        return _jsbsim(plan, opts, seed, refs, limits)
     rng_turb, rng_qc, rng_gps = (np.random.default_rng(s)
                                  for s in np.random.SeedSequence(seed).spawn(3))
-    refs = references(plan, opts.rate_hz)
     wind = wind_field(plan, refs, opts, rng_turb)
+    speed_loop = opts.speed_loop
     if speed_loop is None:
         speed_loop = tune_autothrottle(0.5 * float(plan.tas_mps.min() + plan.tas_mps.max()))
     states, path_index = fly(refs, wind, speed_loop, limits)
     states, w_up = _plunge(refs, wind, states, opts)
     flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps, w_up)
     tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)
-    history = _history(plan, refs, wind, states, flight, qc, vel) if keep_history else None
+    history = _history(plan, refs, wind, states, flight, qc, vel) if opts.keep_history else None
     return flight, _truth(plan, opts, seed, states, tracking, _loop_record(speed_loop), history)
+
+
+def simulate_jsbsim(plan, options=None, *, seed=0, **overrides):
+    """`simulate` with ``engine="jsbsim"`` (JSBSim's six-degree-of-freedom model, see
+    `SimulationOptions`); the truth's options add `engine`, `aircraft`, `center_deg` and the
+    Milspec settings with the sigma they make."""
+    return simulate(plan, simulation_options(options, {"engine": "jsbsim", **overrides},
+                                             caller="simulate_jsbsim"), seed=seed)
+
+
+def _jsbsim(plan, opts, seed, refs, limits):
+    """(Flight, Truth) of the plan flown by JSBSim (maneuvers.fly.jsbsim_flight)."""
+    from .jsbsim_flight import fly_jsbsim
+
+    flown = fly_jsbsim(plan, opts, seed, refs, limits)
+    tracking = _tracking(plan, refs, flown.states, flown.path_index, flown.flight.rho_kgm3)
+    return flown.flight, _truth(plan, opts, seed, flown.states, tracking, flown.speed_loop,
+                                flown.history, options=flown.options, air_data="compressible")
 
 
 def _loop_record(speed_loop):

@@ -2,7 +2,7 @@
 
 `plan_maneuver` runs three steps:
 
-1. feasibility: every argument checked, then the analytic conditions a plan must meet -
+1. feasibility: every field of the `PlanRequest` checked (maneuvers.plan.request), then the analytic conditions a plan must meet -
    cas_min < cas_max, the acceleration limit against the duration, the turn available at full
    bank against 360 deg per coverage group, the wind against the slowest airspeed, the still-air
    turn radius against the test area - each refusal naming the value that works;
@@ -20,24 +20,23 @@ from functools import lru_cache
 import numpy as np
 from .ocp import ManeuverProblem, PathSolution, turn_radius_m
 from .request import (
+    MAX_ITER,
     MAX_NODES,
+    PlanRequest,
     check_node_count,
-    request,
+    plan_request,
+    working_request,
 )
 
-from pitotcal.core.checks import choice, option_dict
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import Plan
-from pitotcal.core.scenario import T2_PLAN
 from pitotcal.core.units import G0_MPS2, RHO0_KGM3, mps_to_kt, wind_vector_mps
 
-__all__ = ["MAX_ITER", "MAX_NODES", "ManeuverProblem", "PathSolution", "check_converged",
-           "plan_maneuver", "turn_radius_m", "wind_vector_mps"]
+__all__ = ["MAX_ITER", "MAX_NODES", "ManeuverProblem", "PathSolution", "PlanRequest",
+           "check_converged", "plan_maneuver", "turn_radius_m", "wind_vector_mps"]
 
 log = logging.getLogger(__name__)
 
-# IPOPT's iteration limit: the T-2 plans take 30-80 iterations, a 4000 s plan ~440.
-MAX_ITER = 300
 # IPOPT statuses that say the constraints cannot be met (any other failure proves nothing)
 _INFEASIBLE = ("Infeasible_Problem_Detected",)
 
@@ -217,57 +216,20 @@ def _build_plan(req, schedule, sol, extra):
                 iterations=sol.iterations)
 
 
-def _design_options(design, design_options):
-    """The checked options of an optimal design; None for the paper's profiles."""
-    if choice("design", design, ("paper", "optimal")) == "paper":
-        return None
-    from .design_request import checked_options
-    return checked_options(design_options)
-
-
-def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
-                  cas_max_kt=T2_PLAN["cas_max_kt"], radius_m=T2_PLAN["radius_m"],
-                  altitude_m=T2_PLAN["altitude_m"], duration_s=T2_PLAN["duration_s"],
-                  bank_max_deg=T2_PLAN["bank_max_deg"], wind_speed_mps=T2_PLAN["wind_speed_mps"],
-                  wind_from_deg=T2_PLAN["wind_from_deg"], *, roll_rate_max_dps=None,
-                  accel_max_mps2=None, levels=4, return_leg=False, turn="right", dt_s=1.0,
-                  margin_m=1.0, heading_margin_deg=15.0, max_iter=MAX_ITER, ipopt_options=None,
-                  design="paper", design_options=None):
+def plan_maneuver(request=None, *positional, **overrides):
     """Plan a calibration maneuver: fixed q(t) schedule, optimised lateral path.
 
     Parameters
     ----------
-    profile : {"continuous", "step-pause", "two-speed"}
-        Airspeed schedule (maneuvers/profiles.py).
-    cas_min_kt, cas_max_kt : float
-        Calibrated airspeed range, knots.
-    radius_m : float
-        Radius of the test area around its centre; the ground track stays inside it at every
-        node in the given wind.
-    altitude_m : float
-        Constant plan altitude (ISA density there gives TAS from CAS).
-    duration_s, bank_max_deg : float
-        Maneuver length, s; bank limit, degrees.
-    wind_speed_mps, wind_from_deg : float
-        Expected mean wind: speed, and the direction it blows FROM (deg true, in [0, 360)).
-    roll_rate_max_dps, accel_max_mps2 : float, optional
-        Roll-rate and acceleration limits (default: `pitotcal.core.dynamics.Limits`).
-    levels : int
-        Step-pause levels, equally spaced in q.
-    return_leg : bool
-        Continuous profile: sweep back down to cas_min in the second half.
-    turn : {"right", "left", "both"}
-        Turn direction; "both" alternates from one coverage group to the next.
-    dt_s : float
-        Node spacing of the plan, s.
-    margin_m, heading_margin_deg : float
-        Radius margin against overshoot between nodes; turn beyond 360 deg demanded in each
-        third of the q range.
-    max_iter, ipopt_options : int, dict (optional)
-        IPOPT's iteration limit, and options passed to it on top of that.
-    design, design_options : {"paper", "optimal"}, dict or maneuvers.plan.design_request.DesignOptions
-        "optimal": the speed schedule designed for information (maneuvers.plan.design) replaces
-        `profile`'s (the plan's profile is then "optimal"), with these options.
+    request : PlanRequest, optional
+        What to plan (maneuvers.plan.request.PlanRequest, every field checked when it is made;
+        defaults: the paper's T-2 case). For compatibility the first arguments may also be
+        given in their old positional order: ``plan_maneuver("two-speed", 70, 90)`` (profile,
+        cas_min_kt, cas_max_kt, radius_m, altitude_m, duration_s, bank_max_deg,
+        wind_speed_mps, wind_from_deg).
+    **overrides
+        Fields of `PlanRequest` by name (``cas_min_kt=60``, ``design="optimal"``, ...), put
+        into `request`: with both, the overrides win. An unknown name is a TypeError.
 
     Returns
     -------
@@ -290,16 +252,13 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
     >>> plan = plan_maneuver()           # the T-2 case: 70-100 KCAS, 926 m, 240 s
     >>> plan.success, plan.n
     (True, 241)
+    >>> plan = plan_maneuver(PlanRequest(profile="two-speed", radius_m=600.0), turn="left")
     """
-    req = request(profile, cas_min_kt, cas_max_kt, radius_m, altitude_m, duration_s,
-                   bank_max_deg, wind_speed_mps, wind_from_deg, roll_rate_max_dps,
-                   accel_max_mps2, levels, return_leg, turn, dt_s, margin_m, heading_margin_deg,
-                   max_iter)
-    ipopt_options = None if ipopt_options is None else option_dict("ipopt_options", ipopt_options)
-    options = _design_options(design, design_options)
-    asked = req
+    asked = plan_request(request, positional, overrides)
+    req = working_request(asked)
+    options = asked.design_options
     schedule, req, extra = _feasible_schedule(req, options)
-    sol = _solve(req, schedule, ipopt_options)
+    sol = _solve(req, schedule, asked.ipopt_options)
     if options is not None:
         from .design_request import record_prediction
         extra = record_prediction(extra, schedule, sol, req, options)
@@ -309,8 +268,8 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
             # wind and the turn give may predict a little worse: design again with that margin
             if (design := _target_margin(extra, design)) is None:
                 break
-            schedule, req, extra = _feasible_schedule(asked, design)
-            sol = _solve(req, schedule, ipopt_options)
+            schedule, req, extra = _feasible_schedule(working_request(asked), design)
+            sol = _solve(req, schedule, asked.ipopt_options)
             extra = record_prediction({**extra, "target_2sigma_kt": options.target_2sigma_kt},
                                       schedule, sol, req, options)
         _warn_target_missed(extra, req.duration_s)

@@ -63,8 +63,6 @@ def fly(plan_kwargs=None, sim_kwargs=None, seed=0):
 def _fly_cached(plan_key, sim_key, seed):
     from pitotcal.maneuvers import simulate
     sim = json.loads(sim_key)
-    if sim.pop("engine", "own") == "jsbsim":
-        from pitotcal.maneuvers.fly.jsbsim_flight import simulate_jsbsim as simulate
     for name in ("k", "wind_drift_mps2"):      # JSON turned tuples into lists
         if name in sim:
             sim[name] = tuple(sim[name])

@@ -153,7 +153,7 @@ def test_bad_input_exits_2_with_one_line(tmp_path, capsys, case, content, match)
                             r"\(the file spans 0 to 79.98 s\)")),
     (["--start-s", "50", "--end-s", "10"], "--start-s 50 must be before --end-s 10$"),
     (["--end-s", "nan"], "--end-s nan must be a finite number$"),
-    (["--gps-noise-mps", "-1"], "--gps-noise-mps -1 must be >= 0 and < 10"),
+    (["--gps-noise-mps", "-1"], "--gps-noise-mps -1 must be >= 0 and <= 10"),
 ])
 def test_bad_options_exit_2(flight_csv, capsys, args, match):
     import re

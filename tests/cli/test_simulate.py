@@ -54,7 +54,7 @@ def test_warns_when_the_flight_leaves_the_paper_tolerances(tmp_path, plan_csv, c
 @pytest.mark.parametrize("content, args, message", [
     ("x,y\n1,2\n", [], "missing column time_s"),
     (None, [], "cannot read plan"),
-    ("PLAN", ["--model", "cubic"], "--model: model 'cubic' is not one of"),
+    ("PLAN", ["--model", "cubic"], "--model 'cubic' is not one of constant, linear, inverse"),
     ("PLAN", ["--model", "constant", "--k2", "3"], "--k2: model 'constant' has only 1"),
     # every option the simulator checks is named by its flag
     ("PLAN", ["--rate-hz", "-5"], "--rate-hz -5 must be > 0"),

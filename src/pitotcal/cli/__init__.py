@@ -59,9 +59,9 @@ def build_parser():
 # The readers' window parameters, shown as the flags where a message names them with a value
 # or a rule ("start_s=10", "start_s 5 must be ..."), never inside a file name.
 _WINDOW = re.compile(r"(?<![\w/.\\-])(start_s|end_s)(?:(=)|(?= (?:[-+]?[\d.]|must\b|is\b)))")
-# Library parameters whose flag has another name and unit (oat_k is also a flight-CSV column,
+# Library parameters whose flag has another name or unit (oat_k is also a flight-CSV column,
 # so it is replaced only when the error is about it).
-_FLAG_DEST = {"oat_k": "oat_c"}
+_FLAG_DEST = {"oat_k": "oat_c", "gps_noise_std_mps": "gps_noise_mps"}
 
 
 def flag_message(parser, args, exc):

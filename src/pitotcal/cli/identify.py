@@ -141,8 +141,6 @@ def run(args):
 
     choice("model", args.model, [*MODELS, "auto"])
     choice("air", args.air, AIR_CHOICES)
-    if args.gps_noise_mps is not None:
-        number("gps_noise_mps", args.gps_noise_mps, 0.0, 10.0, hi_open=True)
     source = Path(args.flight)
     plot_path = _checked_outputs(args, source)
     number("temp_recovery", args.temp_recovery, 0.0, 1.0)

@@ -76,13 +76,7 @@ def run(args):
     geo = _geo_settings(args)
     _check_outputs(args, paths)
     calibration = _calibration(args.calibration)
-    design_options = _design_options(args)          # fills in --profile's default
-    plan = plan_maneuver(
-        args.profile, args.cas_min_kt, args.cas_max_kt, args.radius_m, args.altitude_m,
-        args.duration_s, args.bank_max_deg, args.wind_speed_mps, args.wind_from_deg,
-        roll_rate_max_dps=args.roll_rate_max_dps, accel_max_mps2=args.accel_max_mps2,
-        levels=4 if args.levels is None else args.levels, return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s,
-        max_iter=max_iter, design=args.design, design_options=design_options)
+    plan = plan_maneuver(_request(args, max_iter))
     check_converged(plan, max_iter)
     if geo or calibration:
         plan = dataclasses.replace(plan, settings={**plan.settings, **geo, **calibration})
@@ -167,9 +161,9 @@ def _geo_settings(args):
     return geo
 
 
-_DESIGN_FLAGS = {"turbulence_mps": "--turbulence-mps", "criterion": "--criterion",
-                 "target_2sigma_kt": "--target-2sigma-kt", "stall_kt": "--stall-kt",
-                 "stall_margin": "--stall-margin", "check_fraction": "--check-fraction"}
+# The design flags' fields (maneuvers.plan.design_request.DesignOptions).
+_DESIGN_FIELDS = ("turbulence_mps", "criterion", "target_2sigma_kt", "stall_kt", "stall_margin",
+                  "check_fraction")
 
 
 def _add_design_arguments(p):
@@ -195,11 +189,14 @@ def _add_design_arguments(p):
                         "(default: 0.1; 0: two speeds only)")
 
 
-def _design_options(args):
-    """The design flags as `design_options` (None with the paper design; a design flag
-    without --design optimal is an error, not silently ignored)."""
-    given = {name: getattr(args, name) for name in _DESIGN_FLAGS
-             if getattr(args, name) is not None}
+def _request(args, max_iter):
+    """The flags as the library's `PlanRequest`: it checks each value, naming the field, which
+    `pitotcal.cli.flag_message` shows as its flag (a design flag without --design optimal
+    included). Only what the command line alone has is checked here: --profile, --levels and
+    --return given with --design optimal, which chooses its own speed schedule (the library
+    cannot tell them from their defaults)."""
+    from pitotcal.maneuvers.plan.request import PlanRequest
+
     paper_only = {"--profile": args.profile, "--levels": args.levels,
                   "--return": args.return_leg or None}
     for flag, value in paper_only.items():
@@ -209,18 +206,18 @@ def _design_options(args):
             shown = flag if value is True else f"{flag} {value}"
             raise PitotcalError(f"{shown} is for --design paper: --design optimal chooses its "
                                 f"own speed schedule")
-    if args.profile is None:
-        from pitotcal.core.scenario import T2_PLAN
-
-        args.profile = T2_PLAN["profile"]
-    if args.design != "optimal":
-        if given:
-            from pitotcal.core.errors import PitotcalError
-
-            flag = _DESIGN_FLAGS[next(iter(given))]
-            raise PitotcalError(f"{flag} is for --design optimal")
-        return None
-    return given
+    given = {name: getattr(args, name) for name in _DESIGN_FIELDS
+             if getattr(args, name) is not None}
+    # --profile and --levels when given, else the library's defaults
+    schedule = {name: value for name, value in (("profile", args.profile),
+                                                ("levels", args.levels)) if value is not None}
+    return PlanRequest(
+        cas_min_kt=args.cas_min_kt, cas_max_kt=args.cas_max_kt, radius_m=args.radius_m,
+        altitude_m=args.altitude_m, duration_s=args.duration_s, bank_max_deg=args.bank_max_deg,
+        wind_speed_mps=args.wind_speed_mps, wind_from_deg=args.wind_from_deg,
+        roll_rate_max_dps=args.roll_rate_max_dps, accel_max_mps2=args.accel_max_mps2,
+        return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s, max_iter=max_iter,
+        design=args.design, design_options=given or None, **schedule)
 
 
 def _check_outputs(args, paths):

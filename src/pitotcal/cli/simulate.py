@@ -42,7 +42,6 @@ def add_parser(subparsers):
                    help="time-correlated (Gauss-Markov) GPS velocity error std, m/s (0: none)")
     s.add_argument("--gps-gm-tau-s", type=float, default=30.0,
                    help="its correlation time, s (30)")
-    # issue 11: Dryden's vertical gust flown (plunge, altitude, GPS climb, V_t)
     s.add_argument("--vertical-gusts", action="store_true",
                    help="fly the vertical gust too: the aircraft plunges with it and the "
                         "airspeed includes the air-relative climb (own engine; JSBSim's "
@@ -64,7 +63,7 @@ def add_parser(subparsers):
                         "fraction low), icing (SIZE kt/min), water (SIZE fraction); the truth "
                         "JSON gets \"fault\"")
     a = p.add_argument_group(
-        "air-data sensors (issue 9)",
+        "air-data sensors",
         "with any of these the flight also logs ps_pa, oat_k or tat_k, and rh_pct")
     a.add_argument("--tat-recovery", type=float, default=None, metavar="R",
                    help="log a total-temperature probe of recovery factor R (tat_k) instead of "
@@ -82,19 +81,6 @@ def add_parser(subparsers):
     return p
 
 
-def _air_sensor_option(args):
-    """{"air_sensors": ...} for `simulate` when any was given (own engine only), else {}."""
-    sensors = _air_sensors(args)
-    if sensors is None:
-        return {}
-    if args.engine != "own":
-        from pitotcal.core.errors import PitotcalError
-        raise PitotcalError("the air-data sensor options (--tat-recovery, --rh-percent, "
-                            "--probe-arm-m, --oat-bias-k, --gps-bias-mps) apply to --engine own "
-                            "only")
-    return {"air_sensors": sensors}
-
-
 def _air_sensors(args):
     """The `air_sensors` dict of the options given, or None (then the files are as before)."""
     given = {"tat_recovery": args.tat_recovery, "rh_pct": args.rh_percent,
@@ -104,24 +90,26 @@ def _air_sensors(args):
     return given or None
 
 
-def _true_k(args):
-    """The true coefficients: the model's defaults with --k1 / --k2 put in."""
-    from pitotcal.core.errors import PitotcalError
-    from pitotcal.core.models import get_model
-    from pitotcal.core.scenario import true_k
+def _options(args):
+    """The flags as the library's `SimulationOptions`: it checks each value, naming the field,
+    which `pitotcal.cli.flag_message` shows as its flag; --k1 / --k2 replace the model's
+    default coefficients by name."""
+    from pitotcal.maneuvers.fly.options import SimulationOptions
 
-    try:
-        model = get_model(args.model)
-    except ValueError as exc:
-        raise PitotcalError(f"--model: {exc}") from None
-    k = list(true_k(model.name))
-    for i, value in enumerate((args.k1, args.k2)):
-        if value is not None:
-            if i >= len(model.params):
-                raise PitotcalError(f"--k{i + 1}: model {model.name!r} has only "
-                                    f"{len(model.params)} coefficient(s)")
-            k[i] = value
-    return model, tuple(k)
+    k = {name: value for name, value in (("k1", args.k1), ("k2", args.k2)) if value is not None}
+    return SimulationOptions(
+        model=args.model, k=k or None, wind_speed_mps=args.wind_speed_mps,
+        wind_from_deg=args.wind_from_deg,
+        wind_drift_mps2=(args.wind_drift_n_mps2, args.wind_drift_e_mps2),
+        turbulence_mps=args.turbulence_mps, turbulence_length_m=args.turbulence_length_m,
+        rate_hz=args.rate_hz, qc_noise_pa=args.qc_noise_pa,
+        qc_quantization_pa=args.qc_quantization_pa, qc_bias_pa=args.qc_bias_pa,
+        qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
+        gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
+        gps_latency_s=args.gps_latency_s, air_data=args.air_data,
+        air_sensors=_air_sensors(args), gps_gm_sigma_mps=args.gps_gm_sigma_mps,
+        gps_gm_tau_s=args.gps_gm_tau_s, vertical_gusts=args.vertical_gusts,
+        engine=args.engine, aircraft=args.aircraft, keep_history=args.fault is not None)
 
 
 def _outputs(args):
@@ -142,54 +130,23 @@ def _outputs(args):
     return out, truth_out
 
 
-def _engine(args):
-    """The simulate function of --engine, with --aircraft (refused where it means nothing)."""
-    from functools import partial
-
-    from pitotcal.core.errors import PitotcalError
-
-    if args.engine == "own":
-        if args.aircraft is not None:
-            raise PitotcalError("--aircraft: only --engine jsbsim flies an aircraft model")
-        from pitotcal.maneuvers.fly.simulator import simulate
-
-        return simulate
-    if args.air_data not in (None, "compressible"):
-        raise PitotcalError(f"--air-data {args.air_data}: JSBSim's impact pressure is its own "
-                            "isentropic total pressure minus static (compressible)")
-    from pitotcal.maneuvers.fly.jsbsim_engine import DEFAULT_AIRCRAFT
-    from pitotcal.maneuvers.fly.jsbsim_flight import simulate_jsbsim
-
-    return partial(simulate_jsbsim, aircraft=args.aircraft or DEFAULT_AIRCRAFT)
-
-
 def run(args):
     import warnings
 
     from pitotcal.io import write_flight_csv
+    from pitotcal.core.models import get_model
     from pitotcal.io.plan_csv import read_plan
+    from pitotcal.maneuvers.fly.simulator import simulate
     from pitotcal.maneuvers.fly.truth import tracking_warnings, write_truth_json
 
-    model, k = _true_k(args)
+    options = _options(args)
     out, truth_out = _outputs(args)
     fault = None
     if args.fault is not None:
         from pitotcal.maneuvers.fly.faults import parse_fault
         fault = parse_fault(args.fault, seed=args.seed)
     plan = read_plan(args.plan)
-    flight, truth = _engine(args)(
-        plan, seed=args.seed, model=model.name, k=k, wind_speed_mps=args.wind_speed_mps,
-        wind_from_deg=args.wind_from_deg,
-        wind_drift_mps2=(args.wind_drift_n_mps2, args.wind_drift_e_mps2),
-        turbulence_mps=args.turbulence_mps, turbulence_length_m=args.turbulence_length_m,
-        rate_hz=args.rate_hz, qc_noise_pa=args.qc_noise_pa,
-        qc_quantization_pa=args.qc_quantization_pa, qc_bias_pa=args.qc_bias_pa,
-        qc_scale_error=args.qc_scale_error, pneumatic_lag_s=args.pneumatic_lag_s,
-        gps_rate_hz=args.gps_rate_hz, gps_noise_mps=args.gps_noise_mps,
-        gps_latency_s=args.gps_latency_s, air_data=args.air_data or "incompressible",
-        keep_history=fault is not None, gps_gm_sigma_mps=args.gps_gm_sigma_mps,
-        gps_gm_tau_s=args.gps_gm_tau_s, **_air_sensor_option(args),
-        **({"vertical_gusts": True} if args.vertical_gusts else {}))
+    flight, truth = simulate(plan, options, seed=args.seed)
     if fault is not None:
         from pitotcal.maneuvers.fly.faults import apply_fault
         flight = apply_fault(flight, truth, fault)
@@ -204,6 +161,7 @@ def run(args):
     for message in tracking_warnings(truth):
         warnings.warn(message, stacklevel=2)
     tr, par = truth.tracking, truth.parameters
+    model = get_model(truth.model)
     coeffs = ", ".join(f"{name} {par[name]:g}" for name in model.params)
     print(f"truth: {model.name} {coeffs}; wind {par['wind_speed_mps']:.2f} m/s from "
           f"{par['wind_from_deg']:.1f} deg; tracking: CAS within {tr.max_cas_error_kt:.1f} kt, "

@@ -8,8 +8,8 @@ holds the airspeed within ±5 KCAS of the target and the altitude within ±50 ft
 
 from types import MappingProxyType
 
-__all__ = ["ALT_TOLERANCE_FT", "CAS_TOLERANCE_KT", "MIN_CLEARANCE_M", "T2_PLAN", "TRUE_K",
-           "true_k"]
+__all__ = ["ALT_TOLERANCE_FT", "CAS_TOLERANCE_KT", "GPS_NOISE_MAX_MPS", "MIN_CLEARANCE_M",
+           "T2_PLAN", "TRUE_K", "true_k"]
 
 T2_PLAN = MappingProxyType({
     "profile": "continuous", "cas_min_kt": 70.0, "cas_max_kt": 100.0, "radius_m": 926.0,
@@ -36,3 +36,9 @@ MIN_CLEARANCE_M = 30.0
 def true_k(model_name):
     """The default true coefficients of a model structure (the inverse ones for an unknown name)."""
     return tuple(TRUE_K.get(model_name, TRUE_K["inverse"]))
+
+
+# The largest GPS velocity noise std (per component, m/s) simulated or assumed in a fit: receivers
+# report 0.02-0.5 m/s RMS. One bound for `simulate(gps_noise_mps=)` and
+# `identify(gps_noise_std_mps=)`, so the command line's --gps-noise-mps means the same in both.
+GPS_NOISE_MAX_MPS = 10.0

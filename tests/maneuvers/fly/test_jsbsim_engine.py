@@ -13,7 +13,7 @@ from pitotcal.core.units import FT_TO_M, mps_to_kt
 
 jsbsim = pytest.importorskip("jsbsim", reason="JSBSim is not installed (pip install jsbsim)")
 engine = pytest.importorskip("pitotcal.maneuvers.fly.jsbsim_engine")
-from pitotcal.maneuvers.fly.jsbsim_flight import simulate_jsbsim
+from pitotcal.maneuvers.fly.simulator import simulate_jsbsim
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 from pitotcal.maneuvers.plan.request import MAX_DURATION_S, MAX_NODES, min_dt_s
 from pitotcal.maneuvers.plan.planner import plan_maneuver
-from pitotcal.maneuvers.fly.options import MAX_SAMPLES, MIN_SAMPLES, SIM_LIMITS, _check_samples
+from pitotcal.maneuvers.fly.flyable import check_samples as _check_samples
+from pitotcal.maneuvers.fly.options import MAX_SAMPLES, MIN_SAMPLES, SIM_LIMITS
 from pitotcal.maneuvers.fly.simulator import simulate
 from plans import circle_plan
 
