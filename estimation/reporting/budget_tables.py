@@ -7,6 +7,7 @@ budget; these functions add to what it makes:
   `dv_U_kt` and `u_dv_by_source_kt` in each `airspeed_correction` row and the top-level
   `uncertainty_budget` list (docs/interfaces.md, "Uncertainty budget");
 - `budget_summary(result, budget)`: the text printed after the summary;
+- `budget_report(result_dict)`: the report's budget tables, by source and by speed;
 - `plot_budget_band(ax, result, budget)`: the expanded-uncertainty band on the ΔV axes of the
   calibration figure (`IdentificationResult.plot` returns the figure; its first axes).
 """
@@ -15,7 +16,8 @@ import numpy as np
 
 from ..identification.budget import COVERAGE_K
 
-__all__ = ["SOURCE_LABELS", "add_budget", "budget_summary", "plot_budget_band", "source_label"]
+__all__ = ["SOURCE_LABELS", "add_budget", "budget_report", "budget_summary", "plot_budget_band",
+           "source_label"]
 
 # each source of the budget in words (report tables) and as a short column head (summary
 # text), in SOURCES order after the statistical term
@@ -81,6 +83,32 @@ def budget_summary(result, budget):
                  else "(2σ / 2)")
         lines.append(f"  {row['source']:<20}{given:>14}{row['u_dv_kt']:15.3f}")
     return "\n".join(lines)
+
+
+def budget_report(result):
+    """The budget tables of the calibration report, from a result JSON: `sources` [{label,
+    input, u_max, vi_at_max}] and, when every correction row carries each source per speed
+    (`u_dv_by_source_kt`), `heads` and `by_speed` [{vi, u: [...], U}] in the order of
+    `uncertainty_budget`."""
+    rows = result.get("airspeed_correction") or []
+    entries = [b for b in result.get("uncertainty_budget") or [] if isinstance(b, dict)]
+    names = [b.get("source", "") for b in entries]
+    per = [r for r in rows if isinstance(r.get("u_dv_by_source_kt"), dict)]
+    per = per if per and len(per) == len(rows) else []
+    sources = []
+    for b in entries:
+        u_in, unit = b.get("u_input"), b.get("unit", "")
+        given = ("—" if u_in is None else f"{100 * u_in:.3g} % of reading" if unit == "1"
+                 else f"{u_in:.3g} {unit}".strip())
+        at = None
+        if per and (b.get("u_dv_kt") or 0.0) >= 5e-4:        # a zero term has no largest
+            at = max(per, key=lambda r: r["u_dv_by_source_kt"].get(b["source"], -1.0))["vi_kt"]
+        sources.append({"label": source_label(b.get("source", "")), "input": given,
+                        "u_max": b.get("u_dv_kt"), "vi_at_max": at})
+    by_speed = [{"vi": r["vi_kt"], "u": [r["u_dv_by_source_kt"].get(n) for n in names],
+                 "U": r.get("dv_U_kt")} for r in per]
+    heads = [SOURCE_LABELS.get(n, (n, n))[1] for n in names]
+    return {"sources": sources, "heads": heads, "by_speed": by_speed}
 
 
 def plot_budget_band(ax, result, budget):

@@ -16,14 +16,17 @@ import tomllib
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from pitotcal.core.errors import PitotcalError
 from pitotcal.io.atomic import atomic_open, atomic_path
 
 from . import compliance as comp
+from .budget_tables import budget_report
+from .conditions import turbulence_text
 
-__all__ = ["AIRCRAFT_FIELDS", "TURBULENCE_WORDS", "build_report", "make_report",
-           "read_aircraft", "read_result", "render_html", "sha256", "turbulence_rms_mps",
-           "write_pdf"]
+__all__ = ["AIRCRAFT_FIELDS", "build_report", "make_report", "read_aircraft", "read_result",
+           "render_html", "sha256", "write_pdf"]
 
 # The title block: (TOML table, key, label), in the order shown.
 AIRCRAFT_FIELDS = (
@@ -133,7 +136,7 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         "method": _method(result),
         "correction_rows": [_correction_row(r) for r in rows],
         "has_u": has_u,
-        "budget": _budget(result, rows),
+        "budget": budget_report(result),
         "altimeter_rows": [r for r in rows if r.get("dh_ft") is not None],
         "mach_rows": _mach_rows(result),
         "figures": figures,
@@ -181,11 +184,11 @@ def _conditions(result, flight):
             ("Samples used", (f"{result.get('n_samples', '—')} "
                              f"({result.get('n_dropped', 0)} dropped by the reader)")),
             ("Residual RMS", f"{_fmt(result.get('noise_std_pa'), '.2f')} Pa"),
-            ("Turbulence indication", _turbulence(result))]
+            ("Turbulence indication", turbulence_text(result))]
     if flight is not None:
         t = flight.time_s
         rows.append(("Flight time", f"{t[-1] - t[0]:.0f} s ({t[0]:.1f}–{t[-1]:.1f} s)"))
-        if flight.alt_m is not None and (alt := flight.alt_m[~_isnan(flight.alt_m)]).size:
+        if flight.alt_m is not None and (alt := flight.alt_m[np.isfinite(flight.alt_m)]).size:
             lo, hi = f"{m_to_ft(alt.min()):.0f}", f"{m_to_ft(alt.max()):.0f}"
             rows.append(("Altitude (GPS)", f"{lo} ft" if lo == hi else f"{lo}–{hi} ft"))
         lo, hi = f"{flight.rho_kgm3.min():.4f}", f"{flight.rho_kgm3.max():.4f}"
@@ -196,48 +199,6 @@ def _conditions(result, flight):
     if result.get("source"):
         rows.append(("Result source", str(result["source"])))
     return rows
-
-
-def _isnan(a):
-    import numpy as np
-    return np.isnan(np.asarray(a, dtype=float))
-
-
-# Turbulence words by the RMS gust along the flight path, m/s. MIL-HDBK-1797 (MIL-F-8785C)
-# low-altitude Dryden: sigma_w = 0.1 W20 with W20 = 15 / 30 / 45 kt for light / moderate /
-# severe, i.e. sigma ~ 0.8 / 1.5 / 2.3 m/s (sigma_u >= sigma_w below 1000 ft). A word applies
-# from about the geometric mean of its level and the one below; below a quarter of light's,
-# the residual is GPS and transducer noise, not air.
-TURBULENCE_WORDS = ((0.2, "calm"), (1.1, "light"), (2.0, "moderate"), (math.inf, "severe"))
-
-
-def turbulence_rms_mps(result):
-    """The output residual RMS as equivalent airspeed, m/s: noise_std_pa / sqrt(mean((rho0
-    V_i)^2)) over the correction table's speeds (dq_c/dV = rho V). A gust u along the path
-    moves q_ci by rho V u, so this is the along-path gust RMS, plus the GPS velocity and
-    transducer noise (an upper bound); None when the result lacks noise_std_pa or speeds."""
-    from pitotcal.core.units import RHO0_KGM3, kt_to_mps
-
-    noise = result.get("noise_std_pa")
-    vi = [r["vi_kt"] for r in result.get("airspeed_correction") or []
-          if r.get("vi_kt") is not None]
-    if noise is None or not vi or not math.isfinite(noise):
-        return None
-    rho_v = RHO0_KGM3 * kt_to_mps(vi)
-    return float(noise / math.sqrt(float((rho_v ** 2).mean())))
-
-
-def _turbulence(result):
-    """The turbulence word of `TURBULENCE_WORDS` and the airspeed RMS it rests on."""
-    from pitotcal.core.units import mps_to_kt
-
-    sigma = turbulence_rms_mps(result)
-    if sigma is None:
-        return "—"
-    word = next(w for top, w in TURBULENCE_WORDS if sigma < top)
-    return (f"{word}: residual {sigma:.2f} m/s ({mps_to_kt(sigma):.1f} kt) RMS of equivalent "
-            "airspeed, gusts along the path plus GPS noise (light / moderate / severe ≈ "
-            "0.8 / 1.5 / 2.3 m/s, MIL-HDBK-1797)")
 
 
 def _method(result):
@@ -268,40 +229,12 @@ def _option_rows(options):
     """(name, text) of the options given, as a person reads them: unset ones (None, False,
     empty) left out, True as "yes", sequences space-separated, numbers in %g."""
     def text(v):
-        if v is True:
-            return "yes"
         if isinstance(v, (list, tuple)):
             return " ".join(text(x) for x in v)
-        return format(v, "g") if isinstance(v, float) else str(v)
+        return "yes" if v is True else format(v, "g") if isinstance(v, float) else str(v)
 
     return [(k.replace("_", " "), text(v)) for k, v in sorted((options or {}).items())
-            if v is not None and v is not False and v != () and v != [] and v != ""]
-
-
-def _budget(result, rows):
-    """The budget tables: `sources` [{label, input, u_max, vi_at_max}] and, when the rows carry
-    each source per speed (`u_dv_by_source_kt`), `heads` and `by_speed` [{vi, u: [...], uc,
-    U}] in `uncertainty_budget` order."""
-    from .budget_tables import SOURCE_LABELS, source_label
-
-    entries = [b for b in result.get("uncertainty_budget") or [] if isinstance(b, dict)]
-    names = [b.get("source", "") for b in entries]
-    per = [r for r in rows if isinstance(r.get("u_dv_by_source_kt"), dict)]
-    per = per if per and len(per) == len(rows) else []
-    sources = []
-    for b in entries:
-        u_in, unit = b.get("u_input"), b.get("unit", "")
-        given = ("—" if u_in is None else f"{100 * u_in:.3g} % of reading" if unit == "1"
-                 else f"{u_in:.3g} {unit}".strip())
-        at = None
-        if per and (b.get("u_dv_kt") or 0.0) >= 5e-4:        # a zero term has no largest
-            at = max(per, key=lambda r: r["u_dv_by_source_kt"].get(b["source"], -1.0))["vi_kt"]
-        sources.append({"label": source_label(b.get("source", "")), "input": given,
-                        "u_max": b.get("u_dv_kt"), "vi_at_max": at})
-    by_speed = [{"vi": r["vi_kt"], "u": [r["u_dv_by_source_kt"].get(n) for n in names],
-                 "U": r.get("dv_U_kt")} for r in per]
-    heads = [SOURCE_LABELS.get(n, (n, n))[1] for n in names]
-    return {"sources": sources, "heads": heads, "by_speed": by_speed}
+            if v is not None and v is not False and v not in ((), [], "")]
 
 
 def _correction_row(r):
@@ -398,7 +331,6 @@ def read_result(path):
         raise PitotcalError(f"{path}: not a result of `pitotcal identify --json` or "
                             "`pitotcal legs --json` (no airspeed_correction table)")
     return doc
-
 
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,

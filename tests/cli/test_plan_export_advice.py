@@ -8,7 +8,7 @@ import pytest
 
 from pitotcal.cli import main
 from pitotcal.core.errors import PlanInfeasibleError
-from pitotcal.maneuvers.plan.missions import check_ground_clearance
+from pitotcal.maneuvers.plan.export_checks import check_ground_clearance
 
 SITL = ["--center", "47.39774", "8.54559"]
 

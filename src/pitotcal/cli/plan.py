@@ -119,7 +119,7 @@ def _geo_settings(args):
     from pitotcal.core.errors import PitotcalError
 
     if args.export:
-        from pitotcal.maneuvers.plan.missions import check_exportable_turn
+        from pitotcal.maneuvers.plan.export_checks import check_exportable_turn
 
         check_exportable_turn(args.turn)        # before planning: no radius advice first
     elif args.ground_elevation_m is not None:

@@ -4,11 +4,8 @@ word follows the Dryden intensity flown, and the RMS it rests on is that intensi
 import warnings
 
 import pytest
-from pitotcal.estimation.reporting.calibration_report import (
-    TURBULENCE_WORDS,
-    build_report,
-    turbulence_rms_mps,
-)
+from pitotcal.estimation.reporting.calibration_report import build_report
+from pitotcal.estimation.reporting.conditions import TURBULENCE_WORDS, turbulence_rms_mps
 
 import pitotcal
 from pitotcal.core.scenario import T2_PLAN
