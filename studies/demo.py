@@ -84,9 +84,8 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     import time
 
     from pitotcal.estimation import identify
-    from pitotcal.maneuvers import plan_maneuver, simulate, write_truth_json
-
     from pitotcal.io import write_flight_csv, write_plan
+    from pitotcal.maneuvers import plan_maneuver, simulate, write_truth_json
 
     duration_s, rate_hz = positive("duration_s", duration_s), positive("rate_hz", rate_hz)
     out = output_folder(out_dir, "the plan, flight, result and figures")
@@ -116,7 +115,7 @@ def run_demo(out_dir="pitotcal-demo", *, seed=0, duration_s=T2_PLAN["duration_s"
     write_json(files["result_json"], doc)
     files["plan_png"] = _plan_figure(plan, out)
     files["calibration_png"] = out / "calibration.png"
-    result.plot(files["calibration_png"])
+    _calibration_figure(result, result.budget, files["calibration_png"])
     files["residuals_png"] = _residual_figure(result, out)
     clock["write"] = time.perf_counter() - t0
     t0 = time.perf_counter()
@@ -166,6 +165,17 @@ def _report(result, flight, files, out):
     path = out / "report.html"
     with atomic_open(path, "w", encoding="utf-8") as fh:
         fh.write(render_html(context))
+    return path
+
+
+def _calibration_figure(result, budget, path):
+    """The paper-style calibration figure with the budget's U band on its ΔV panel."""
+    from pitotcal.estimation.reporting.budget_tables import plot_budget_band
+    from pitotcal.io.atomic import save_figure
+
+    fig = result.plot()
+    plot_budget_band(fig.axes[0], result, budget)
+    save_figure(fig, path, dpi=110)
     return path
 
 

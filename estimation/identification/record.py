@@ -86,11 +86,17 @@ def _static_source_record(result):
 
 
 def with_budget(out, budget):
-    """`out` (a record) with `dv_U_kt` per correction row, `uncertainty_budget`, and the
+    """`out` (a record) with `dv_U_kt` and `u_dv_by_source_kt` (each source's standard
+    uncertainty of ΔV at that speed, kt) per correction row, `uncertainty_budget`, and the
     budget's warnings; the rows are matched by speed (the budget has the table's speeds)."""
-    rows = out.get("airspeed_correction", [])
-    u_by_vi = {round(float(v), 6): float(u) for v, u in zip(budget.vi_kt, budget.expanded_kt)}
-    new_rows = [{**row, "dv_U_kt": u_by_vi.get(round(float(row["vi_kt"]), 6))} for row in rows]
+    at = {round(float(v), 6): i for i, v in enumerate(budget.vi_kt)}
+    new_rows = []
+    for row in out.get("airspeed_correction", []):
+        i = at.get(round(float(row["vi_kt"]), 6))
+        new_rows.append({**row, **({"dv_U_kt": None} if i is None else {
+            "dv_U_kt": float(budget.expanded_kt[i]),
+            "u_dv_by_source_kt": {"statistical": float(budget.statistical_kt[i]),
+                                  **{n: float(u[i]) for n, u in budget.terms_kt.items()}}})})
     warnings = list(out.get("warnings", []))
     warnings += [w for w in budget.warnings if w not in warnings]
     return json_ready({**out, "airspeed_correction": new_rows,

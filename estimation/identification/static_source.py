@@ -177,7 +177,7 @@ def plot_altimeter_correction(ax, result, vi_range_kt):
     dh, band = grid["dh_ft"], grid["dh_2sigma_ft"]
     ax.fill_between(vi, dh - band, dh + band, color="tab:green", alpha=0.3, label="2σ")
     ax.plot(vi, dh, color="tab:green", lw=2, label="ΔH_pc = H_c − H_ic")
-    ax.set(xlabel="indicated airspeed V_ic (kt)", ylabel="ΔH_pc (ft)",
+    ax.set(xlabel="indicated airspeed V_i (kt)", ylabel="ΔH_pc (ft)",
            title=f"Altimeter correction at {grid['pressure_altitude_ic_ft']:.0f} ft "
                  "pressure altitude")
     ax.legend(fontsize=8, loc="best")

@@ -235,7 +235,8 @@ def legs_from_flight(flight, windows, point_tol_kt=POINT_TOL_KT, pool=True):
     legs = LegData(point=labels, ias_kt=ias, qci_pa=r[:, 3], pressure_alt_m=alt_m,
                    oat_k=r[:, 5], groundspeed_mps=np.hypot(r[:, 0], r[:, 1]),
                    track_deg=np.degrees(np.arctan2(r[:, 1], r[:, 0])) % 360.0,
-                   duration_s=r[:, 6], groundspeed_sd_mps=r[:, 2], source=flight.source)
+                   duration_s=r[:, 6], groundspeed_sd_mps=r[:, 2], source=flight.source,
+                   sd_from="samples")
     return pool_sd(legs) if pool else legs, np.array([row[8:10] for row in rows], dtype=float)
 
 

@@ -246,7 +246,7 @@ def _result(legs, pe, wind, labels, sol, scales, sigma, stated):
             f"({wind}); fly points over a wider speed range, or more tracks per point")
     dof = m - p
     if stated:
-        s2, factor, source = 1.0, 2.0, "stated"
+        s2, factor, source = 1.0, 2.0, legs.sd_from
         noise = float(np.sqrt(np.mean(sigma ** 2)))
     else:
         s2 = float(np.sum(sol.fun ** 2) / dof)
@@ -255,7 +255,7 @@ def _result(legs, pe, wind, labels, sol, scales, sigma, stated):
     scale = np.r_[scales, np.ones(p - nk)]
     cov = cov_z * np.outer(scale, scale)
     notes = []
-    if stated and dof > 0:
+    if stated and legs.sd_from == "stated" and dof > 0:
         chi2 = float(np.sum(sol.fun ** 2))
         from scipy.stats import chi2 as chi2_dist
         if chi2_dist.sf(chi2, dof) < 0.01:

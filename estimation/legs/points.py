@@ -14,7 +14,8 @@ Bounds, linearised: the implicit-function Jacobian of the solution with respect 
 ground-velocity vector, J = −(∂F/∂x)⁻¹ ∂F/∂g, F_i = |g_i − w|² − V², x = (w_N, w_E, V), with a
 per-leg velocity error σ_i per component: Cov x = J diag(σ²) Jᵀ (the tangential part of each
 error moves g_i along the circle and drops out). σ_i is the stated `groundspeed_sd_kt` when
-every leg of the point has it ("stated"; bound 2σ); otherwise, with four or more legs, the
+every leg of the point has it ("stated", or "samples" when the legs' own GPS samples give it,
+`estimation.legs.flight`; bound 2σ); otherwise, with four or more legs, the
 scatter of the legs about the circle, s² = Σ r_i² / (N − 3) with r_i = |g_i − w| − V, and the
 half-width t₀.₉₇₅(N − 3) s |J_V| (Student t: with four legs one degree of freedom, t = 12.7;
 "scatter"). Three legs without a stated accuracy carry no information on their own error
@@ -66,7 +67,7 @@ class PointSolution:
     half_width_factor : float
         Multiplier of the standard deviations for the 95 % half-widths (2, or Student t).
     bound : str
-        "stated", "scatter" or "none".
+        "stated", "samples" (the sd the legs' own GPS samples give), "scatter" or "none".
     dop : float
         TAS error per unit leg velocity error (`DOP_MAX`).
     tas_subset_sd_mps : float
@@ -254,7 +255,7 @@ def solve_point(legs, label):
     resid = np.hypot(*(g - x[:2]).T) - x[2]
     sd = legs.groundspeed_sd_mps[idx]
     if np.all(np.isfinite(sd)):
-        bound, factor, sigma = "stated", 2.0, np.repeat(sd, 2)
+        bound, factor, sigma = legs.sd_from, 2.0, np.repeat(sd, 2)
     elif n > 3:
         s = float(np.sqrt(np.sum(resid ** 2) / (n - 3)))
         bound, factor, sigma = "scatter", float(student_t.ppf(0.975, n - 3)), np.full(2 * n, s)

@@ -82,7 +82,7 @@ def legs_summary(legs, points, fit, notes):
     """The text `pitotcal legs` prints (knots, degrees true, wind FROM)."""
     lines = [f"Legs: {legs.source} ({legs.n} legs, {len(points)} points)", "",
              ("Per point, the classic solution (±: 95 % half-width; bound: stated GPS accuracy, "
-             "leg scatter, or none):"),
+             "samples (the legs' own GPS scatter), leg scatter, or none):"),
              (f"  {'point':<7}{'method':<7}{'KIAS':>6}{'KTAS':>8}{'±':>6}{'wind kt':>9}"
              f"{'from':>6}{'ΔV kt':>8}{'±':>6}  {'bound':<8}{'avg-GS bias':>11}")]
     for s in points:
@@ -112,7 +112,7 @@ def _global_text(fit):
         out.append(f"  wind {w['group']}: {w['wind_speed_kt']:.1f} kt from "
                    f"{w['wind_from_deg']:.0f}° (±{w['wind_2sigma_kt']:.1f} kt)")
     out += ["", ("Airspeed correction, ΔV = V_c − V_ic (add ΔV to the indicated airspeed; ±: 95 % "
-                "half-width, 2σ with a stated accuracy):"),
+                "half-width, 2σ when each leg carries its accuracy):"),
             f"  {'KIAS':>7}{'ΔV kt':>9}{'±95% kt':>10}{'KCAS':>8}"]
     out += [f"  {r['vi_kt']:7.1f}{r['dv_kt']:+9.2f}{r['dv_2sigma_kt']:10.2f}{r['vc_kt']:8.1f}"
             for r in d["airspeed_correction"]]
@@ -133,8 +133,9 @@ def plot_legs(points, fit, path, series=None):
         vi = np.linspace(lo, hi, 200)
         dv, half = fit.delta_v_kt(vi)
         name = "global fit" if series is None else "global fit over the legs"
+        two_sigma = fit.noise_source in ("stated", "samples")
         ax.fill_between(vi, dv - half, dv + half, color="C0", alpha=0.25,
-                        label=f"{name} ({fit.model}) ±2σ" if fit.noise_source == "stated"
+                        label=f"{name} ({fit.model}) ±2σ" if two_sigma
                         else f"{name} ({fit.model}), 95 % band")
         ax.plot(vi, dv, color="C0", lw=2)
     if series is not None:

@@ -3,9 +3,10 @@
 The budget's presentation beside the identification's own (estimation.identification.view):
 
 - `add_budget(out, budget)`: the result dict of `IdentificationResult.to_dict()` gains
-  `dv_U_kt` in each `airspeed_correction` row and the top-level `uncertainty_budget` list
-  (docs/interfaces.md, "Uncertainty budget");
+  `dv_U_kt` and `u_dv_by_source_kt` in each `airspeed_correction` row and the top-level
+  `uncertainty_budget` list (docs/interfaces.md, "Uncertainty budget");
 - `budget_summary(result, budget)`: the text printed after the summary;
+- `budget_report(result_dict)`: the report's budget tables, by source and by speed;
 - `plot_budget_band(ax, result, budget)`: the expanded-uncertainty band on the ΔV axes of the
   calibration figure (`IdentificationResult.plot` returns the figure; its first axes).
 """
@@ -15,11 +16,25 @@ import numpy as np
 from ..identification.budget import COVERAGE_K
 from ..identification.record import with_budget
 
-__all__ = ["add_budget", "budget_summary", "plot_budget_band"]
+__all__ = ["SOURCE_LABELS", "add_budget", "budget_report", "budget_summary", "plot_budget_band",
+           "source_label"]
 
-# short column heads of the per-speed table, in SOURCES order
-_HEADS = {"oat": "OAT", "humidity": "RH", "gps_velocity_bias": "GPSb", "gps_latency": "lat",
-          "probe_lever_arm": "arm", "qc_scale": "scale", "qc_offset": "offs"}
+# each source of the budget in words (report tables) and as a short column head (summary
+# text), in SOURCES order after the statistical term
+SOURCE_LABELS = {"statistical": ("Statistical (the fit's 2σ / 2)", "stat"),
+                 "oat": ("Outside air temperature", "OAT"),
+                 "humidity": ("Relative humidity", "RH"),
+                 "gps_velocity_bias": ("GPS velocity bias", "GPSb"),
+                 "gps_latency": ("GPS latency", "lat"),
+                 "probe_lever_arm": ("Probe lever arm", "arm"),
+                 "qc_scale": ("Impact-pressure transducer scale", "scale"),
+                 "qc_offset": ("Impact-pressure transducer offset", "offs")}
+_HEADS = {k: short for k, (_, short) in SOURCE_LABELS.items()}
+
+
+def source_label(name):
+    """A budget source in words (the name itself, spaced, when it is not one of ours)."""
+    return SOURCE_LABELS.get(name, (name.replace("_", " "), name))[0]
 
 
 def add_budget(out, budget):
@@ -55,17 +70,40 @@ def budget_summary(result, budget):
     return "\n".join(lines)
 
 
+def budget_report(result):
+    """The budget tables of the calibration report, from a result JSON: `sources` [{label,
+    input, u_max, vi_at_max}] and, when every correction row carries each source per speed
+    (`u_dv_by_source_kt`), `heads` and `by_speed` [{vi, u: [...], U}] in the order of
+    `uncertainty_budget`."""
+    rows = result.get("airspeed_correction") or []
+    entries = [b for b in result.get("uncertainty_budget") or [] if isinstance(b, dict)]
+    names = [b.get("source", "") for b in entries]
+    per = [r for r in rows if isinstance(r.get("u_dv_by_source_kt"), dict)]
+    per = per if per and len(per) == len(rows) else []
+    sources = []
+    for b in entries:
+        u_in, unit = b.get("u_input"), b.get("unit", "")
+        given = ("—" if u_in is None else f"{100 * u_in:.3g} % of reading" if unit == "1"
+                 else f"{u_in:.3g} {unit}".strip())
+        at = None
+        if per and (b.get("u_dv_kt") or 0.0) >= 5e-4:        # a zero term has no largest
+            at = max(per, key=lambda r: r["u_dv_by_source_kt"].get(b["source"], -1.0))["vi_kt"]
+        sources.append({"label": source_label(b.get("source", "")), "input": given,
+                        "u_max": b.get("u_dv_kt"), "vi_at_max": at})
+    by_speed = [{"vi": r["vi_kt"], "u": [r["u_dv_by_source_kt"].get(n) for n in names],
+                 "U": r.get("dv_U_kt")} for r in per]
+    heads = [SOURCE_LABELS.get(n, (n, n))[1] for n in names]
+    return {"sources": sources, "heads": heads, "by_speed": by_speed}
+
+
 def plot_budget_band(ax, result, budget):
     """Draw ΔV ± U (k = 2) over the flown speeds on `ax`, beside the statistical 2σ band.
 
     Between the table's speeds U is interpolated linearly (it varies slowly with V_i).
     """
+    from .figures import draw_u_band
+
     vi = np.linspace(float(budget.vi_kt[0]), float(budget.vi_kt[-1]), 200)
     dv = np.asarray(result.delta_v_kt(vi)[0], dtype=float) * np.ones_like(vi)
-    u = np.interp(vi, budget.vi_kt, budget.expanded_kt)
-    ax.fill_between(vi, dv - u, dv + u, facecolor="none", edgecolor="tab:orange", hatch="//",
-                    lw=0.0, alpha=0.7, label=f"U (k = {COVERAGE_K:g}): statistical + Type B")
-    for sign in (-1, 1):
-        ax.plot(vi, dv + sign * u, color="tab:orange", lw=1.2)
-    ax.legend(fontsize=8, loc="best")
+    draw_u_band(ax, vi, dv, np.interp(vi, budget.vi_kt, budget.expanded_kt))
     return ax

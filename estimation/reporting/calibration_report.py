@@ -16,10 +16,14 @@ import tomllib
 import warnings
 from pathlib import Path
 
+import numpy as np
+
 from pitotcal.core.errors import PitotcalError
 from pitotcal.io.atomic import atomic_open, atomic_path
 
 from . import compliance as comp
+from .budget_tables import budget_report
+from .conditions import turbulence_text
 
 __all__ = ["AIRCRAFT_FIELDS", "build_report", "make_report", "read_aircraft", "read_result",
            "render_html", "sha256", "write_pdf"]
@@ -122,7 +126,7 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         if "points" not in result:      # a legs result is another method: not comparable
             warnings += _reproduces(result, ident)
         figures.append(("Calibration (paper Figs. 7-8 style), with the residual time history",
-                        _png(figs.calibration_png(ident))))
+                        _png(figs.calibration_png(ident, result))))
         figures.append(("Ground track and residual distribution", _png(figs.track_png(flight,
                                                                                       ident))))
     now = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M:%S UTC")
@@ -132,14 +136,14 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         "method": _method(result),
         "correction_rows": [_correction_row(r) for r in rows],
         "has_u": has_u,
-        "budget": result.get("uncertainty_budget") or [],
+        "budget": budget_report(result),
         "altimeter_rows": [r for r in rows if r.get("dh_ft") is not None],
         "mach_rows": _mach_rows(result),
         "figures": figures,
         "warnings": warnings,
         "compliance": block,
         "legs": _legs(result),
-        "provenance": {"version": __version__, "date": now, "options": dict(options or {}),
+        "provenance": {"version": __version__, "date": now, "options": _option_rows(options),
                        "inputs": [(role, str(p), sha256(p)) for role, p in inputs]},
         "fmt": _fmt,
     }
@@ -180,37 +184,21 @@ def _conditions(result, flight):
             ("Samples used", (f"{result.get('n_samples', '—')} "
                              f"({result.get('n_dropped', 0)} dropped by the reader)")),
             ("Residual RMS", f"{_fmt(result.get('noise_std_pa'), '.2f')} Pa"),
-            ("Turbulence indication", _turbulence(result))]
+            ("Turbulence indication", turbulence_text(result))]
     if flight is not None:
         t = flight.time_s
         rows.append(("Flight time", f"{t[-1] - t[0]:.0f} s ({t[0]:.1f}–{t[-1]:.1f} s)"))
-        if flight.alt_m is not None and (alt := flight.alt_m[~_isnan(flight.alt_m)]).size:
-            rows.append(("Altitude", f"{m_to_ft(alt.min()):.0f}–{m_to_ft(alt.max()):.0f} ft"))
-        rho = flight.rho_kgm3
-        rows.append(("Air density", f"{rho.min():.4f}–{rho.max():.4f} kg/m³"))
+        if flight.alt_m is not None and (alt := flight.alt_m[np.isfinite(flight.alt_m)]).size:
+            lo, hi = f"{m_to_ft(alt.min()):.0f}", f"{m_to_ft(alt.max()):.0f}"
+            rows.append(("Altitude (GPS)", f"{lo} ft" if lo == hi else f"{lo}–{hi} ft"))
+        lo, hi = f"{flight.rho_kgm3.min():.4f}", f"{flight.rho_kgm3.max():.4f}"
+        rows.append(("Air density", f"{lo} kg/m³" if lo == hi else f"{lo}–{hi} kg/m³"))
         for key in ("oat_source", "temperature_source", "autopilot", "firmware"):
             if key in flight.meta:
                 rows.append((key.replace("_", " ").capitalize(), str(flight.meta[key])))
-    rows.append(("Result source", str(result.get("source", "—"))))
+    if result.get("source"):
+        rows.append(("Result source", str(result["source"])))
     return rows
-
-
-def _isnan(a):
-    import numpy as np
-    return np.isnan(np.asarray(a, dtype=float))
-
-
-def _turbulence(result):
-    """How far the colored-residual 2σ exceeds the plain one: ~1 in still air, larger with
-    turbulence or wind change (estimation.uncertainty.covariance)."""
-    k1 = (result.get("parameters") or {}).get("k1") or {}
-    std, plain = k1.get("std"), k1.get("std_plain")
-    if not std or not plain:
-        return "—"
-    ratio = std / plain
-    word = "calm" if ratio < 1.5 else "light" if ratio < 4 else "moderate or more"
-    return (f"{word}: the corrected k1 2σ is {ratio:.1f}× the plain Hessian one "
-            "(correlated residuals)")
 
 
 def _method(result):
@@ -235,6 +223,18 @@ def _method(result):
                         "2σ: statistical, corrected for coloured residuals (no budget in the "
                         "result: systematic contributions not included)"),
     ]
+
+
+def _option_rows(options):
+    """(name, text) of the options given, as a person reads them: unset ones (None, False,
+    empty) left out, True as "yes", sequences space-separated, numbers in %g."""
+    def text(v):
+        if isinstance(v, (list, tuple)):
+            return " ".join(text(x) for x in v)
+        return "yes" if v is True else format(v, "g") if isinstance(v, float) else str(v)
+
+    return [(k.replace("_", " "), text(v)) for k, v in sorted((options or {}).items())
+            if v is not None and v is not False and v not in ((), [], "")]
 
 
 def _correction_row(r):
@@ -331,7 +331,6 @@ def read_result(path):
 
 # the reading a result records that `read_flight` takes (its "oat_source" is a description)
 _READING_OPTIONS = ("start_s", "end_s", "oat_k", "temp_recovery", "rh_pct")
-
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
                 aircraft_path=None,

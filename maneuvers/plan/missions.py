@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pitotcal.core.checks import choice
+from pitotcal.core.checks import choice, number
 from pitotcal.core.errors import PlanInfeasibleError
 from pitotcal.core.geo import check_lat_lon
 from pitotcal.core.plan import Plan
@@ -32,6 +32,8 @@ from pitotcal.core.units import (
     mps_to_kt,
     wind_vector_mps,
 )
+from .export_checks import check_exportable_turn, check_ground_clearance
+
 from pitotcal.io.mission_files import (
     FRAME_GLOBAL,
     FRAME_GLOBAL_RELATIVE_ALT,
@@ -219,11 +221,7 @@ def check_loiter(plan):
     the highest ground speed, downwind at the fastest airspeed.
     """
     s = plan.settings
-    if s.get("turn") == "both":
-        raise PlanInfeasibleError(
-            "turn both cannot be exported: the mission is one loiter circle at the centre, "
-            "flown one way (ArduPilot and PX4 take the direction per loiter item, not within "
-            "one); export a plan with turn right or left", param="turn")
+    check_exportable_turn(s.get("turn", "right"))
     radius, wind = float(s["radius_m"]), float(s["wind_speed_mps"])
     bank_max = float(s["bank_max_deg"])
     vg_max = float(np.max(plan.tas_mps)) + wind
@@ -256,7 +254,8 @@ def check_loiter(plan):
     return bank, math.degrees(turn)
 
 
-def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl"):
+def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl",
+                  ground_elevation_m=None):
     """The plan as mission items at the test-area centre (after `check_loiter`).
 
     Parameters
@@ -269,6 +268,10 @@ def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl"):
         "msl": the loiters at the plan's altitude above mean sea level (MAV_FRAME_GLOBAL) - the
         altitude whose ISA density the plan's true airspeeds use; "agl": the same number above
         home (MAV_FRAME_GLOBAL_RELATIVE_ALT).
+    ground_elevation_m : float, optional
+        The ground at the centre, m above mean sea level: a loiter less than
+        `MIN_CLEARANCE_M` above it is refused; without it an "msl" mission is a warning
+        (`check_ground_clearance`).
 
     Returns
     -------
@@ -279,7 +282,10 @@ def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl"):
     """
     lat, lon = check_lat_lon(center_lat_deg, center_lon_deg)
     altitude_ref = choice("altitude_ref", altitude_ref, ALTITUDE_REFS)
+    if ground_elevation_m is not None:
+        ground_elevation_m = number("ground_elevation_m", ground_elevation_m, -500.0, 9000.0)
     bank, turn = check_loiter(plan)
+    check_ground_clearance(float(plan.settings["altitude_m"]), altitude_ref, ground_elevation_m)
     s = plan.settings
     radius = float(s["radius_m"]) * (1.0 if s.get("turn", "right") == "right" else -1.0)
     frame = FRAME_GLOBAL if altitude_ref == "msl" else FRAME_GLOBAL_RELATIVE_ALT
@@ -303,23 +309,26 @@ def mission_path(plan_csv, autopilot):
 
 
 def export_mission(plan, path, autopilot, center_lat_deg, center_lon_deg, *,
-                   altitude_ref="msl"):
+                   altitude_ref="msl", ground_elevation_m=None):
     """Check the loiter, build the mission and write it; returns the `Mission`.
 
     `autopilot` "ardupilot" writes QGC WPL 110 text (Mission Planner, MAVProxy), "px4" a
-    QGroundControl .plan JSON. Raises PlanInfeasibleError (see `check_loiter`) or
-    PitotcalError for a bad centre or choice, before writing anything.
+    QGroundControl .plan JSON. Raises PlanInfeasibleError (see `check_loiter`,
+    `check_ground_clearance`) or PitotcalError for a bad centre or choice, before writing
+    anything.
 
     Example
     -------
     >>> from pitotcal.maneuvers.plan.planner import plan_maneuver
     >>> plan = plan_maneuver("two-speed", radius_m=600.0)
-    >>> m = export_mission(plan, "/tmp/p.waypoints", "ardupilot", 47.4, 8.55)
+    >>> m = export_mission(plan, "/tmp/p.waypoints", "ardupilot", 47.4, 8.55,
+    ...                    ground_elevation_m=0.0)
     >>> [round(float(mps_to_kt(v))) for v in m.cas_mps], m.loiter_s
     ([70, 100], (112, 128))
     """
     autopilot = choice("autopilot", autopilot, AUTOPILOTS)
-    mission = build_mission(plan, center_lat_deg, center_lon_deg, altitude_ref=altitude_ref)
+    mission = build_mission(plan, center_lat_deg, center_lon_deg, altitude_ref=altitude_ref,
+                            ground_elevation_m=ground_elevation_m)
     write_mission(mission, path, autopilot)
     return mission
 

@@ -149,3 +149,20 @@ def test_utf16_leg_and_plan_files_are_named_utf16(tmp_path):
     plan.write_bytes(plan.read_text().encode("utf-16"))
     with pytest.raises(PitotcalError, match="cannot read plan: UTF-16 text"):
         read_plan(plan)
+
+
+def test_refusal_of_1e200_cells_is_the_only_stderr_line(tmp_path):
+    """No numpy overflow line before the refusal: stderr of a real `pitotcal identify` run
+    (default warning filters, not pytest's) is exactly the one refusal line."""
+    import subprocess
+    import sys
+
+    cells = {(r, "gps_vn_mps"): "1e200" for r in range(100, 120)}
+    path = write(tmp_path / "f.csv", columns(), cells)
+    done = subprocess.run([sys.executable, "-m", "pitotcal", "identify", str(path), "--air",
+                           "incompressible"], capture_output=True, text=True, timeout=120,
+                          check=False)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert "column gps_vn_mps, row 101 (line 102): 1e+200 is outside the plausible" in done.stderr
+    assert "overflow" not in done.stderr

@@ -8,7 +8,7 @@ import sys
 def add_parser(subparsers):
     # numpy-free modules: the parser is built for every command
     from pitotcal.core.plan import PROFILES, TURNS
-    from pitotcal.core.scenario import T2_PLAN
+    from pitotcal.core.scenario import MIN_CLEARANCE_M, T2_PLAN
 
     p = subparsers.add_parser(
         "plan", help="plan a calibration maneuver (CasADi/IPOPT)",
@@ -52,6 +52,10 @@ def add_parser(subparsers):
     p.add_argument("--altitude-ref", choices=("msl", "agl"), default=None,
                    help="what --altitude-m is measured from on the card and in the mission "
                         "(default: msl, the altitude whose ISA density gives the TAS)")
+    p.add_argument("--ground-elevation-m", type=float, default=None, metavar="M",
+                   help="with --export: the ground's elevation at --center, m above mean sea "
+                        f"level; a loiter less than {MIN_CLEARANCE_M:g} m above it is refused "
+                        "(without it, an MSL mission is exported with a warning)")
     p.add_argument("--magvar-deg", type=float, default=None, metavar="DEG",
                    help="magnetic variation, east positive: the card adds magnetic headings")
     _add_design_arguments(p)
@@ -96,7 +100,8 @@ def run(args):
         # refused (the loiter's bank or heading coverage) before any file is written
         from pitotcal.maneuvers.plan.missions import build_mission
 
-        mission = build_mission(plan, *args.center, altitude_ref=args.altitude_ref)
+        mission = build_mission(plan, *args.center, altitude_ref=args.altitude_ref,
+                                ground_elevation_m=args.ground_elevation_m)
     paths = write_plan_outputs(plan, args.output, figures=figures)
     if mission is not None:
         from pitotcal.maneuvers.plan.missions import mission_path, write_mission
@@ -106,9 +111,14 @@ def run(args):
     print(plan.summary())
     s = plan.settings
     if s.get("design") == "optimal":
+        met = s.get("target_2sigma_kt") is not None and \
+            s["predicted_dv_2sigma_kt"] <= s["target_2sigma_kt"]
         print(f"  design: dwells {s['dwell_order']} (low, check, high), {s['low_share']:.0%} of "
               f"the end-level time low; predicted {s['criterion']} 2σ of ΔV "
-              f"{s['predicted_dv_2sigma_kt']:.2f} kt in {s['turbulence_mps']:g} m/s turbulence")
+              f"{s['predicted_dv_2sigma_kt']:.2f} kt in {s['turbulence_mps']:g} m/s turbulence"
+              + ("" if s.get("target_2sigma_kt") is None else
+                 f" (target {s['target_2sigma_kt']:g} kt: "
+                 f"{'met' if met else 'NOT met'})"))
     for kind, path in paths.items():
         print(f"  {kind:12s} {path}")
     sys.stdout.flush()
@@ -123,6 +133,13 @@ def _geo_settings(args):
     --center: the plan and card are then what they always were)."""
     from pitotcal.core.errors import PitotcalError
 
+    if args.export:
+        from pitotcal.maneuvers.plan.export_checks import check_exportable_turn
+
+        check_exportable_turn(args.turn)        # before planning: no radius advice first
+    elif args.ground_elevation_m is not None:
+        raise PitotcalError("--ground-elevation-m is for --export: the mission's loiters "
+                            "are checked against it")
     if args.center is None:
         if args.export:
             raise PitotcalError(f"--export {args.export} needs --center LAT LON: the "

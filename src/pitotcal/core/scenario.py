@@ -9,7 +9,7 @@ holds the airspeed within ±5 KCAS of the target and the altitude within ±50 ft
 from types import MappingProxyType
 
 __all__ = ["AIR_DATA_MODES", "ALT_TOLERANCE_FT", "CAS_TOLERANCE_KT", "DEFAULT_AIR_DATA",
-           "GPS_NOISE_MAX_MPS", "T2_PLAN", "TRUE_K", "true_k"]
+           "GPS_NOISE_MAX_MPS", "MIN_CLEARANCE_M", "T2_PLAN", "TRUE_K", "true_k"]
 
 T2_PLAN = MappingProxyType({
     "profile": "continuous", "cas_min_kt": 70.0, "cas_max_kt": 100.0, "radius_m": 926.0,
@@ -35,6 +35,9 @@ DEFAULT_AIR_DATA = "compressible"
 
 CAS_TOLERANCE_KT = 5.0      # the paper's airspeed tolerance about the target, ±KCAS
 ALT_TOLERANCE_FT = 50.0     # and the altitude tolerance, ±ft
+# The least height above the ground at the centre an exported loiter may have, m: 100 ft,
+# below any test altitude (small UAVs fly their tests at up to 120 m, so no higher floor).
+MIN_CLEARANCE_M = 30.0
 
 
 def true_k(model_name):

@@ -223,8 +223,11 @@ def check_units(name, qci, vn, ve, rho):
     The GPS dynamic pressure is the measurement model's q_c with no wind (½ ρ |V_g|²).
     """
     q_med = float(np.median(qci))
-    q_gps = float(np.median(impact_pressure_pa(rho, tas_squared(vn, ve, 0.0, 0.0))))
-    gs_med = float(np.median(np.hypot(vn, ve)))
+    # a glitch cell (1e200) squares to inf here and is named by `check_plausible` after this
+    # check; the medians do not need it, so numpy's overflow line would only precede our one
+    with np.errstate(over="ignore", invalid="ignore"):
+        q_gps = float(np.median(impact_pressure_pa(rho, tas_squared(vn, ve, 0.0, 0.0))))
+        gs_med = float(np.median(np.hypot(vn, ve)))
     ratio = q_med / q_gps if q_gps > 0 else np.inf
     if _RATIO_OK[0] <= ratio <= _RATIO_OK[1]:
         if q_med < QCI_MIN_FLYING_PA:

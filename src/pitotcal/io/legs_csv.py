@@ -73,11 +73,14 @@ class LegData:
     duration_s : ndarray
         Leg duration, s (NaN where not given).
     groundspeed_sd_mps : ndarray
-        Stated standard uncertainty of the leg's ground velocity per component, m/s (NaN where
-        not given).
+        Standard uncertainty of the leg's ground velocity per component, m/s (NaN where not
+        given).
     source : str
     lines : tuple of int
         The file line of each leg, for messages.
+    sd_from : {"stated", "samples"}
+        Where `groundspeed_sd_mps` comes from: the leg file states it, or the legs' own GPS
+        samples (`estimation.legs.flight`) estimate it. The bounds are labelled with it.
     """
 
     point: tuple
@@ -91,6 +94,7 @@ class LegData:
     groundspeed_sd_mps: np.ndarray
     source: str = ""
     lines: tuple = ()
+    sd_from: str = "stated"
 
     @property
     def n(self):

@@ -1,0 +1,275 @@
+"""Regenerate the numbers README.md quotes from fresh runs of its own examples.
+
+Each quoted result sits between ``<!-- readme-numbers:NAME -->`` and
+``<!-- /readme-numbers:NAME -->`` (on one line for a value, around a block for a table or an
+output excerpt). This script runs the example behind each NAME through the command line, as a
+reader would, and writes what it printed between the markers::
+
+    python docs/readme_numbers.py             # rewrite README.md (deterministic examples)
+    python docs/readme_numbers.py --check     # exit 1 naming each block that differs
+    python docs/readme_numbers.py --timings   # also the wall-clock numbers (this machine)
+    python docs/readme_numbers.py --tests     # also time the lean test suite (~90 s alone)
+    python docs/readme_numbers.py --only legs-flight,studies-usage
+
+The real-log example reads the ArduPlane SITL log from $PITOTCAL_SHARED_DATA (else the nearest
+``shared/data`` above this checkout) and is left as it is, with a line saying so, when the log
+is absent. tests/test_readme_numbers.py checks the deterministic blocks.
+"""
+
+import argparse
+import contextlib
+import io
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+README = ROOT / "README.md"
+_BLOCK = re.compile(r"<!-- readme-numbers:(?P<name>[\w-]+) -->(?P<body>.*?)"
+                    r"<!-- /readme-numbers:(?P=name) -->", re.S)
+
+
+def shared_data():
+    """$PITOTCAL_SHARED_DATA, else the nearest shared/data above this checkout (or None)."""
+    if "PITOTCAL_SHARED_DATA" in os.environ:
+        return Path(os.environ["PITOTCAL_SHARED_DATA"])
+    return next((p / "shared" / "data" for p in ROOT.parents if (p / "shared" / "data").is_dir()),
+                None)
+
+
+def _cli(*args):
+    """Run `pitotcal ARGS` in this process; its stdout (warnings silenced)."""
+    import warnings
+
+    from pitotcal.cli import main
+
+    out = io.StringIO()
+    with warnings.catch_warnings(), contextlib.redirect_stdout(out), \
+            contextlib.redirect_stderr(io.StringIO()):
+        warnings.simplefilter("ignore")
+        status = main([str(a) for a in args])
+    if status != 0:
+        raise RuntimeError(f"pitotcal {' '.join(map(str, args))} exited {status}")
+    return out.getvalue()
+
+
+# ---- deterministic examples -------------------------------------------------------------------
+
+def studies_cell(_):
+    from pitotcal.studies import STUDY_NAMES
+
+    return ", ".join(f"`{n}`" for n in STUDY_NAMES)
+
+
+COMPRESSIBLE_PLAN = ("--cas-min-kt", 90, "--cas-max-kt", 150, "--altitude-m", 2438,
+                     "--radius-m", 2000, "--duration-s", 300)
+
+
+def compressible_table(tmp):
+    """The worked example of the compressible air data: plan, simulate, identify both ways."""
+    import numpy as np
+
+    from pitotcal.core import airdata as ad
+    from pitotcal.core import units
+    from pitotcal.core.models import delta_v_kt, get_model, qc_from_qci_pa
+    from pitotcal.io import read_flight
+
+    _cli("plan", *COMPRESSIBLE_PLAN, "--no-figures", "-o", tmp / "p.csv")
+    _cli("simulate", tmp / "p.csv", "-o", tmp / "f.csv", "--seed", 0, "--air-data",
+         "compressible")
+    _cli("identify", tmp / "f.csv", "--no-budget", "--json", tmp / "r.json")
+    _cli("identify", tmp / "f.csv", "--air", "incompressible", "--no-budget", "--json",
+         tmp / "ri.json")
+    res, inc = (json.loads((tmp / n).read_text()) for n in ("r.json", "ri.json"))
+    truth = json.loads((tmp / "f.truth.json").read_text())
+    model = get_model(truth["model"])
+    k = [truth["parameters"][p] for p in model.params]
+    rows = res["airspeed_correction"]
+    pick = [rows[0], *(r for r in rows if r["vi_kt"] in (100.0, 130.0)), rows[-1]]
+    vi = np.array([r["vi_kt"] for r in pick])
+    dv_true = delta_v_kt(model, k, vi, "compressible")
+    ps = float(np.median(read_flight(tmp / "f.csv").ps_pa))
+    qci = ad.qc_from_cas_pa(units.kt_to_mps(vi))
+    dp = qc_from_qci_pa(model, k, qci) - qci
+    dh_true = units.m_to_ft(ad.pressure_altitude_m(ps - dp) - ad.pressure_altitude_m(ps))
+    inc_rows = inc["airspeed_correction"]
+    alt = res["static_source"]["pressure_altitude_ic_ft"]
+    out = ["", f"| V_ic kt | M_ic | ΔV_pc kt ± 2σ | true | ΔH_pc ft ± 2σ ({alt:,.0f} ft) | true | "
+               "`--air incompressible` ΔV |",
+           "|--------:|-----:|--------------:|-----:|-------------------------:|-----:|"
+           "--------------------------:|"]
+    for r, t, h in zip(pick, dv_true, dh_true):
+        # the nearest row of the incompressible table (its V_i is √(2 q_ci / ρ0), its ends
+        # fall a little apart)
+        i = min(inc_rows, key=lambda x: abs(x["vi_kt"] - r["vi_kt"]))
+        other = f"{_sign(i['dv_kt'])} ± {i['dv_2sigma_kt']:.2f}"
+        out.append(f"| {r['vi_kt']:5.1f} | {r['mach_i']:.3f} | {_sign(r['dv_kt'])} ± "
+                   f"{r['dv_2sigma_kt']:.2f} | {_sign(t)} | {_sign(r['dh_ft'], 1)} ± "
+                   f"{r['dh_2sigma_ft']:.1f} | {_sign(h, 1)} | {other} |")
+    return "\n".join(out) + "\n\n"
+
+
+def _sign(x, digits=2):
+    """+0.51 / −0.26 (a real minus, as the README's tables)."""
+    return f"{x:+.{digits}f}".replace("-", "−")
+
+
+LEGS_MAKE = ("from pitotcal.maneuvers.fly.legs import simulate_leg_flight as s; \\\n"
+             "  from pitotcal.io.flight_csv import write_flight_csv as w; "
+             "w(s(seed=3, rate_hz=5)[0], 'legflight.csv')")
+
+
+def _leg_flight(tmp):
+    from pitotcal.io.flight_csv import write_flight_csv
+    from pitotcal.maneuvers.fly.legs import simulate_leg_flight
+
+    flight, truth, _ = simulate_leg_flight(seed=3, rate_hz=5)
+    write_flight_csv(flight, tmp / "legflight.csv")
+    return truth
+
+
+def legs_truth(tmp):
+    return ", ".join(_sign(v) for v in _leg_flight(tmp).dv_kt)
+
+
+def legs_flight(tmp):
+    """The `pitotcal legs FLIGHT` example: its time-series legs and the ΔV comparison."""
+    _leg_flight(tmp)
+    text = _cli("legs", tmp / "legflight.csv", "--legs-out", tmp / "legs.csv", "--json",
+                tmp / "legs.json", "--plot", tmp / "legs.png").splitlines()
+    head = next(i for i, line in enumerate(text) if line.startswith("Legs from the time series"))
+    dv = next(i for i, line in enumerate(text) if line.startswith("ΔV at each point"))
+    excerpt = [*text[head:head + 4], "  ...", *text[dv:dv + 6]]
+    return "\n".join(["", "", "```", f'$ python -c "{LEGS_MAKE}"',
+                      "$ pitotcal legs legflight.csv --legs-out legs.csv --json legs.json "
+                      "--plot legs.png", "...", *excerpt, "```", "", ""])
+
+
+# ---- the real log ---------------------------------------------------------------------------
+
+def sitl_ratio(tmp):
+    """`pitotcal identify arduplane_sitl.log --oat-c 15 --params`: the ratio it recommends."""
+    data = shared_data()
+    log = None if data is None else data / "ardupilot" / "arduplane_sitl.log"
+    if log is None or not log.is_file():
+        return None
+    _cli("identify", log, "--oat-c", 15, "--no-budget", "--params", tmp / "sitl.parm")
+    text = (tmp / "sitl.parm").read_text()
+    value, two = map(float, re.search(r"ARSPD_RATIO = ([\d.]+) \+/- ([\d.]+)", text).groups())
+    current = float(re.search(r"current value ([\d.]+)", text).group(1))
+    return (f"{value:.4f} ± {two:.4f} against the simulator's {current:.4f} "
+            f"({_sign(100 * (value / current - 1), 2)} %)")
+
+
+# ---- wall-clock numbers of this machine -------------------------------------------------------
+
+def _wall(cmd, cwd, runs=3):
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        subprocess.run(cmd, cwd=cwd, check=True, capture_output=True)
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times)
+
+
+def _machine():
+    """The cores and the load the times were measured under (other work slows them)."""
+    return f"{os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}"
+
+
+def demo_time(tmp):
+    s = _wall([sys.executable, "-m", "pitotcal", "demo", "--out", str(tmp / "demo")], tmp)
+    return f"~{s:.0f} s on {_machine()}"
+
+
+def identify_time(tmp):
+    """`pitotcal identify` end to end (import, read, fit, budget, write) on 16,001 samples."""
+    _cli("plan", "--duration-s", 320, "--no-figures", "-o", tmp / "p320.csv")
+    _cli("simulate", tmp / "p320.csv", "-o", tmp / "f320.csv", "--seed", 0, "--air-data",
+         "compressible")
+    cmd = [sys.executable, "-m", "pitotcal", "identify", str(tmp / "f320.csv")]
+    full, bare = _wall(cmd, tmp), _wall([*cmd, "--no-budget"], tmp)
+    return (f"{full:.1f} s end to end on 16,001 samples ({bare:.2f} s with `--no-budget`; "
+            f"{_machine()})")
+
+
+def tests_time(_):
+    s = _wall([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"], ROOT, runs=1)
+    return f"about {10 * round(s / 10):.0f} s on {_machine()}"
+
+
+# name -> (kind, generator); kinds beyond "fixed" run only when asked
+GENERATORS = {
+    "studies-cell": ("fixed", studies_cell),
+    "studies-usage": ("fixed", studies_cell),
+    "compressible-table": ("fixed", compressible_table),
+    "legs-truth": ("fixed", legs_truth),
+    "legs-flight": ("fixed", legs_flight),
+    "sitl-ratio": ("data", sitl_ratio),
+    "demo-time": ("timings", demo_time),
+    "identify-time": ("timings", identify_time),
+    "tests-time": ("tests", tests_time),
+}
+
+
+def blocks(text):
+    """{name: body} of the marked blocks of `text` (a name may appear more than once)."""
+    return {m["name"]: m["body"] for m in _BLOCK.finditer(text)}
+
+
+def generate(names):
+    """{name: fresh body} for `names` (None: the example could not run here)."""
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in names:
+            work = Path(tmp) / name
+            work.mkdir()
+            out[name] = GENERATORS[name][1](work)
+    return out
+
+
+def rewrite(text, fresh):
+    """`text` with each marked block's body replaced by its fresh one (None: left as is)."""
+    def body(m):
+        new = fresh.get(m["name"])
+        return m[0] if new is None else (f"<!-- readme-numbers:{m['name']} -->{new}"
+                                         f"<!-- /readme-numbers:{m['name']} -->")
+    return _BLOCK.sub(body, text)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--check", action="store_true", help="compare only; exit 1 on a difference")
+    p.add_argument("--timings", action="store_true", help="also the wall-clock numbers")
+    p.add_argument("--tests", action="store_true", help="also time the lean test suite")
+    p.add_argument("--only", default=None, help="comma-separated block names")
+    args = p.parse_args(argv)
+    kinds = {"fixed", "data"} | ({"timings"} if args.timings else set()) \
+        | ({"tests"} if args.tests else set())
+    text = README.read_text(encoding="utf-8")
+    present = blocks(text)
+    names = [n for n in GENERATORS if n in present and GENERATORS[n][0] in kinds]
+    if args.only:
+        names = [n for n in args.only.split(",") if n in present]
+    fresh = generate(names)
+    for name, new in fresh.items():
+        if new is None:
+            print(f"{name}: left as it is (its data is absent: set PITOTCAL_SHARED_DATA)")
+    differ = [n for n, new in fresh.items() if new is not None and new != present[n]]
+    if args.check:
+        for name in differ:
+            print(f"{name}: README says {present[name]!r}, a fresh run gives {fresh[name]!r}")
+        return 1 if differ else 0
+    README.write_text(rewrite(text, fresh), encoding="utf-8")
+    print(f"README.md: {len(differ)} of {len(fresh)} blocks rewritten ({', '.join(differ)})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
