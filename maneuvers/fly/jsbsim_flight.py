@@ -125,7 +125,7 @@ def _outputs(plan, refs, opts, seed, record, path_index, engine, keep_history):
                     oat_k=record["oat_k"],
                     source=f"simulate(engine=jsbsim, seed={seed})", meta=meta)
     states = np.column_stack([record[key] for key in _STATES])
-    tracking = _tracking(plan, refs, states, path_index, record["rho_kgm3"])
+    tracking = _tracking(plan, refs, states, path_index)
     realised = {"turbulence_rms_mps": _turbulence_rms(record),
                 "max_sideslip_deg": float(np.degrees(np.max(np.abs(record["beta_rad"])))),
                 "max_alpha_deg": float(np.degrees(np.max(record["alpha_rad"]))),

@@ -83,14 +83,17 @@ def kias_targets(plan):
         return None
     from pitotcal.core import airdata
     from pitotcal.core.models import get_model, qci_from_qc_pa
-    from pitotcal.core.units import incompressible_cas_mps
+    from pitotcal.core.units import incompressible_cas_mps, isa_density_kgm3
 
     if cal.get("air_data") == "compressible":
         # the KCAS target by the standard law: its q_c, what the probe then reads, its V_ic
         qc = airdata.qc_from_cas_pa(plan.cas_mps)
         qci = qci_from_qc_pa(get_model(cal["model"]), cal["k"], qc)
         return mps_to_kt(airdata.cas_from_qc_mps(qci))
-    qci = qci_from_qc_pa(get_model(cal["model"]), cal["k"], plan.qc_pa)
+    # an incompressible calibration relates q_ci to ½ρV_t² (the paper's eq. 2) and reads
+    # V_ic = sqrt(2 q_ci / ρ0)
+    qc = 0.5 * isa_density_kgm3(plan.alt_m) * plan.tas_mps ** 2
+    qci = qci_from_qc_pa(get_model(cal["model"]), cal["k"], qc)
     return mps_to_kt(incompressible_cas_mps(qci))
 
 
