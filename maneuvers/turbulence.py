@@ -1,4 +1,4 @@
-"""Dryden turbulence: MIL-F-8785C shaping filters built with python-control, run on whole arrays.
+"""Dryden turbulence: MIL-F-8785C shaping filters in numpy/scipy, run on whole arrays.
 
 The gust field is frozen and the aircraft flies through it at the mean true airspeed V, so a
 spatial spectrum with scale L becomes a temporal one with time constant L / V. Unit-intensity
@@ -33,8 +33,8 @@ import numpy as np
 from pitotcal.core.checks import integer, number, positive
 from pitotcal.core.units import FT_TO_M
 
-__all__ = ["DrydenScales", "along_path_gust", "dryden_filters", "dryden_gusts", "dryden_scales",
-           "plunge_response"]
+__all__ = ["DrydenScales", "along_path_gust", "discrete_dryden_filters", "dryden_filters",
+           "dryden_gusts", "dryden_scales", "plunge_response"]
 
 _LOW_FT, _HIGH_FT = 1000.0, 2000.0
 _HIGH_SCALE_FT = 1750.0
@@ -108,7 +108,7 @@ def _white_noise(n, dt_s, scales, tas_mps, rng):
 
 
 def dryden_filters(scales, tas_mps):
-    """Continuous shaping filters (u, v, w) as python-control transfer functions.
+    """Continuous shaping filters (u, v, w) as transfer-function coefficients.
 
     Parameters
     ----------
@@ -118,29 +118,56 @@ def dryden_filters(scales, tas_mps):
 
     Returns
     -------
-    tuple of control.TransferFunction
-        H_u, H_v, H_w of the module Notes (input: white noise of spectral density pi).
+    tuple of (ndarray, ndarray)
+        (num, den) of H_u, H_v, H_w of the module Notes, polynomials in s with the highest
+        power first (input: white noise of spectral density pi); what ``control.tf(num, den)``
+        takes, for analysis with python-control.
     """
-    import control
-
     gain_u, t_u = _along_path_filter(scales, tas_mps)
     v = float(tas_mps)
     t_v, t_w = scales.length_v_m / v, scales.length_w_m / v
-    h_u = control.tf([gain_u], [t_u, 1.0])
+    h_u = (np.array([gain_u]), np.array([t_u, 1.0]))
 
     def lateral(sigma, tau):
         gain = sigma * np.sqrt(tau / np.pi)
-        return control.tf([gain * np.sqrt(3.0) * tau, gain], [tau * tau, 2.0 * tau, 1.0])
+        return np.array([gain * np.sqrt(3.0) * tau, gain]), np.array([tau * tau, 2.0 * tau, 1.0])
 
     return h_u, lateral(scales.sigma_v_mps, t_v), lateral(scales.sigma_w_mps, t_w)
+
+
+def discrete_dryden_filters(scales, tas_mps, dt_s):
+    """The shaping filters discretised with a zero-order hold at step `dt_s`, for `lfilter`.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        (num, den) in powers of z^-1 of H_u, H_v, H_w.
+
+    Notes
+    -----
+    `scipy.signal.cont2discrete` (method "zoh") of `dryden_filters`, i.e. what python-control's
+    ``c2d(tf(num, den), dt_s, method="zoh")`` computes. A zero-order hold has no direct
+    feed-through, so the numerator starts with an exact zero; like python-control's transfer
+    functions, the leading zeros are dropped, which advances the response by one sample: the
+    same gust process, since the input is white.
+    """
+    from scipy.signal import cont2discrete
+
+    positive("dt_s", dt_s)
+    out = []
+    for num, den in dryden_filters(scales, tas_mps):
+        numd, dend, _ = cont2discrete((num, den), dt_s, method="zoh")
+        numd = np.trim_zeros(np.ravel(numd), "f")
+        out.append((numd if numd.size else np.zeros(1), np.asarray(dend, dtype=float)))
+    return tuple(out)
 
 
 def dryden_gusts(n, dt_s, scales, tas_mps, rng):
     """Gust time series (u, v, w) of `n` samples at step `dt_s`, stationary from the first sample.
 
-    Each filter is discretised with a zero-order hold (python-control `c2d`) and run over the
-    whole noise array with `scipy.signal.lfilter`; a burn-in of ten time constants is discarded
-    so the series starts in the stationary distribution rather than at zero.
+    Each filter is discretised with a zero-order hold (`discrete_dryden_filters`) and run over
+    the whole noise array with `scipy.signal.lfilter`; a burn-in of ten time constants is
+    discarded so the series starts in the stationary distribution rather than at zero.
 
     Parameters
     ----------
@@ -159,16 +186,11 @@ def dryden_gusts(n, dt_s, scales, tas_mps, rng):
     ndarray, shape (n, 3)
         Columns u (along the path), v (to the right), w (down), m/s.
     """
-    import control
     from scipy.signal import lfilter
 
-    filters = dryden_filters(scales, tas_mps)
     burn, noise = _white_noise(n, dt_s, scales, tas_mps, rng)
     out = np.empty((n, 3))
-    for j, h in enumerate(filters):
-        hd = control.c2d(h, dt_s, method="zoh")
-        num = np.atleast_1d(np.squeeze(hd.num[0][0]))
-        den = np.atleast_1d(np.squeeze(hd.den[0][0]))
+    for j, (num, den) in enumerate(discrete_dryden_filters(scales, tas_mps, dt_s)):
         out[:, j] = lfilter(num, den, noise[j])[burn:]
     return out
 
@@ -178,9 +200,9 @@ def along_path_gust(n, dt_s, scales, tas_mps, rng):
 
     The same noise draws and burn-in as `dryden_gusts`, and the same recursion its
     zero-order-hold filter runs (y_k = c x_k + a y_(k-1), a = exp(-dt / tau_u),
-    c = gain (1 - a)), with `a` and `c` in closed form instead of python-control's `c2d`: for
-    the plan command's auto-throttle check, which should not import python-control or
-    scipy.signal (1.7 s). The simulator keeps `dryden_gusts`, whose numbers its seeds pin.
+    c = gain (1 - a)), with `a` and `c` in closed form instead of `scipy.signal`: for the plan
+    command's auto-throttle check, which should not import scipy.signal. The simulator keeps
+    `dryden_gusts`, whose numbers its seeds pin.
 
     Returns
     -------
