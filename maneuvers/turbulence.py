@@ -1,4 +1,4 @@
-"""Dryden turbulence: MIL-F-8785C shaping filters in numpy/scipy, run on whole arrays.
+"""Dryden turbulence: MIL-F-8785C shaping filters in plain numpy, run on whole arrays.
 
 The gust field is frozen and the aircraft flies through it at the mean true airspeed V, so a
 spatial spectrum with scale L becomes a temporal one with time constant L / V. Unit-intensity
@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pitotcal.core.checks import integer, number, positive
+from pitotcal.core.linear import zoh_transfer_function
 from pitotcal.core.units import FT_TO_M
 
 __all__ = ["DrydenScales", "along_path_gust", "discrete_dryden_filters", "dryden_filters",
@@ -136,38 +137,48 @@ def dryden_filters(scales, tas_mps):
 
 
 def discrete_dryden_filters(scales, tas_mps, dt_s):
-    """The shaping filters discretised with a zero-order hold at step `dt_s`, for `lfilter`.
+    """The shaping filters discretised with a zero-order hold at step `dt_s`.
 
     Returns
     -------
     tuple of (ndarray, ndarray)
-        (num, den) in powers of z^-1 of H_u, H_v, H_w.
+        (num, den) in powers of z^-1 of H_u, H_v, H_w, as ``scipy.signal.lfilter`` takes them.
 
     Notes
     -----
-    `scipy.signal.cont2discrete` (method "zoh") of `dryden_filters`, i.e. what python-control's
-    ``c2d(tf(num, den), dt_s, method="zoh")`` computes. A zero-order hold has no direct
-    feed-through, so the numerator starts with an exact zero; like python-control's transfer
-    functions, the leading zeros are dropped, which advances the response by one sample: the
-    same gust process, since the input is white.
+    `pitotcal.core.linear.zoh_transfer_function` of `dryden_filters`: what python-control's
+    ``c2d(tf(num, den), dt_s, method="zoh")`` computes (through scipy's `cont2discrete`), to
+    rounding, in plain numpy (importing scipy.signal costs `simulate` about 1 s on a busy
+    machine). Its leading zero dropped, the response leads the hold's by one sample: the same
+    gust process, since the input is white.
     """
-    from scipy.signal import cont2discrete
-
     positive("dt_s", dt_s)
+    return tuple(zoh_transfer_function(num, den, dt_s)
+                 for num, den in dryden_filters(scales, tas_mps))
+
+
+def _filter(num, den, x):
+    """``scipy.signal.lfilter(num, den, x)`` for den[0] = 1 and at most second order, from rest:
+    y_k = b0 x_k + b1 x_(k-1) + b2 x_(k-2) - a1 y_(k-1) - a2 y_(k-2), a plain loop over floats."""
+    if len(num) > 3 or len(den) > 3:
+        raise ValueError("_filter runs filters of at most second order")
+    b0, b1, b2 = (*num, 0.0, 0.0, 0.0)[:3]
+    _, a1, a2 = (*den, 0.0, 0.0)[:3]
+    x1 = x2 = y1 = y2 = 0.0
     out = []
-    for num, den in dryden_filters(scales, tas_mps):
-        numd, dend, _ = cont2discrete((num, den), dt_s, method="zoh")
-        numd = np.trim_zeros(np.ravel(numd), "f")
-        out.append((numd if numd.size else np.zeros(1), np.asarray(dend, dtype=float)))
-    return tuple(out)
+    for v in x.tolist():
+        y = b0 * v + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2
+        out.append(y)
+        x2, x1, y2, y1 = x1, v, y1, y
+    return np.array(out)
 
 
 def dryden_gusts(n, dt_s, scales, tas_mps, rng):
     """Gust time series (u, v, w) of `n` samples at step `dt_s`, stationary from the first sample.
 
     Each filter is discretised with a zero-order hold (`discrete_dryden_filters`) and run over
-    the whole noise array with `scipy.signal.lfilter`; a burn-in of ten time constants is
-    discarded so the series starts in the stationary distribution rather than at zero.
+    the whole noise array; a burn-in of ten time constants is discarded so the series starts in
+    the stationary distribution rather than at zero.
 
     Parameters
     ----------
@@ -186,12 +197,10 @@ def dryden_gusts(n, dt_s, scales, tas_mps, rng):
     ndarray, shape (n, 3)
         Columns u (along the path), v (to the right), w (down), m/s.
     """
-    from scipy.signal import lfilter
-
     burn, noise = _white_noise(n, dt_s, scales, tas_mps, rng)
     out = np.empty((n, 3))
     for j, (num, den) in enumerate(discrete_dryden_filters(scales, tas_mps, dt_s)):
-        out[:, j] = lfilter(num, den, noise[j])[burn:]
+        out[:, j] = _filter(num, den, noise[j])[burn:]
     return out
 
 
@@ -200,9 +209,8 @@ def along_path_gust(n, dt_s, scales, tas_mps, rng):
 
     The same noise draws and burn-in as `dryden_gusts`, and the same recursion its
     zero-order-hold filter runs (y_k = c x_k + a y_(k-1), a = exp(-dt / tau_u),
-    c = gain (1 - a)), with `a` and `c` in closed form instead of `scipy.signal`: for the plan
-    command's auto-throttle check, which should not import scipy.signal. The simulator keeps
-    `dryden_gusts`, whose numbers its seeds pin.
+    c = gain (1 - a)), with `a` and `c` in closed form: the plan command's auto-throttle check
+    needs the along-path gust alone.
 
     Returns
     -------

@@ -27,6 +27,7 @@ import numpy as np
 
 from pitotcal.core.checks import number, positive
 from pitotcal.core.dynamics import Limits
+from pitotcal.core.linear import expm
 from pitotcal.core.speeds import cas_from_tas_mps
 from pitotcal.core.units import G0_MPS2, mps_to_kt
 
@@ -211,20 +212,6 @@ class AutothrottleCheck:
                 f"({'within' if self.success else 'OUTSIDE'} +-{self.tolerance_kt:g} KCAS)")
 
 
-def _expm(m):
-    """exp(m) of a small matrix: Taylor series after scaling to norm <= 1/2, then squaring."""
-    norm = float(np.max(np.sum(np.abs(m), axis=0)))
-    squarings = math.ceil(math.log2(norm / 0.5)) if norm > 0.5 else 0
-    a = m / 2.0 ** squarings
-    out = term = np.eye(m.shape[0])
-    for k in range(1, 20):                      # |a| <= 1/2: the remainder is below 1e-24
-        term = term @ a / k
-        out = out + term
-    for _ in range(squarings):
-        out = out @ out
-    return out
-
-
 def _lsim_foh(a, b, c, d, dt_s, u):
     """Response from rest of x' = a x + b u, y = c x + d u to the inputs `u` (N, m) sampled
     every `dt_s` and linear in between: exact (python-control's `forced_response`)."""
@@ -232,7 +219,7 @@ def _lsim_foh(a, b, c, d, dt_s, u):
     block = np.zeros((n + 2 * m, n + 2 * m))
     block[:n, :n], block[:n, n:n + m] = a * dt_s, b * dt_s
     block[n:n + m, n + m:] = np.eye(m)
-    e = _expm(block)
+    e = expm(block)
     ad, bd1 = e[:n, :n], e[:n, n + m:]
     drive = u[:-1] @ (e[:n, n:n + m] - bd1).T + u[1:] @ bd1.T
     x = np.zeros((u.shape[0], n))

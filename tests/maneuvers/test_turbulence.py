@@ -90,6 +90,17 @@ def _gusts_with_python_control(n, dt, s, tas, rng):
     return out
 
 
+def test_filter_is_lfilter():
+    from scipy.signal import lfilter
+
+    from pitotcal.maneuvers.turbulence import _filter
+
+    x = np.random.default_rng(3).standard_normal(2000)
+    for num, den in (([0.2], [1.0, -0.9]), ([0.02, -0.019], [1.0, -1.98, 0.9802])):
+        np.testing.assert_allclose(_filter(num, den, x), lfilter(num, den, x), rtol=0,
+                                   atol=1e-12)
+
+
 @pytest.mark.parametrize("alt_m, sigma, tas, dt", CASES)
 def test_gusts_match_python_control(alt_m, sigma, tas, dt):
     s = dryden_scales(alt_m, sigma)
@@ -101,7 +112,8 @@ def test_gusts_match_python_control(alt_m, sigma, tas, dt):
 
 
 def test_simulate_does_not_import_python_control(tmp_path):
-    """`pitotcal simulate` end to end in a fresh interpreter: python-control never loads."""
+    """`pitotcal simulate` end to end in a fresh interpreter: neither python-control nor
+    scipy.signal loads."""
     import subprocess
     import sys
 
@@ -114,7 +126,8 @@ def test_simulate_does_not_import_python_control(tmp_path):
             "from pitotcal.cli import main\n"
             f"status = main(['simulate', {str(plan_csv)!r}, '-o', {str(tmp_path / 'f.csv')!r}])\n"
             "assert status == 0, status\n"
-            "print(sorted(m for m in sys.modules if m == 'control' or m.startswith('control.')))\n")
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'control'\n"
+            "             or m.startswith('scipy.signal')))\n")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, env={**__import__("os").environ, "MPLBACKEND": "Agg"})
     assert out.stdout.strip().splitlines()[-1] == "[]"
