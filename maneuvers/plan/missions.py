@@ -263,8 +263,8 @@ def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl"):
         The test-area centre, degrees (WGS-84), latitude in [-90, 90], longitude in [-180, 180).
     altitude_ref : {"msl", "agl"}
         "msl": the loiters at the plan's altitude above mean sea level (MAV_FRAME_GLOBAL) - the
-        altitude whose ISA density the plan's true airspeeds use; "agl": the same number above
-        home (MAV_FRAME_GLOBAL_RELATIVE_ALT).
+        altitude whose ISA pressure and temperature the plan's true airspeeds use; "agl": the
+        same number above home (MAV_FRAME_GLOBAL_RELATIVE_ALT).
 
     Returns
     -------

@@ -246,7 +246,7 @@ def plan_maneuver(profile=T2_PLAN["profile"], cas_min_kt=T2_PLAN["cas_min_kt"],
         Radius of the test area around its centre; the ground track stays inside it at every
         node in the given wind.
     altitude_m : float
-        Constant plan altitude (ISA density there gives TAS from CAS).
+        Constant plan altitude (the ISA p_s and T there give TAS from CAS).
     duration_s, bank_max_deg : float
         Maneuver length, s; bank limit, degrees.
     wind_speed_mps, wind_from_deg : float

@@ -63,7 +63,7 @@ class Schedule:
     groups: tuple
     levels_qc_pa: tuple
     rho_kgm3: float
-    altitude_m: float = 0.0
+    altitude_m: float
 
     @property
     def n_intervals(self):

@@ -50,7 +50,8 @@ def add_parser(subparsers):
                         "(QGroundControl, PX4); needs --center")
     p.add_argument("--altitude-ref", choices=("msl", "agl"), default=None,
                    help="what --altitude-m is measured from on the card and in the mission "
-                        "(default: msl, the altitude whose ISA density gives the TAS)")
+                        "(default: msl, the altitude whose ISA pressure and temperature give "
+                        "the TAS)")
     p.add_argument("--magvar-deg", type=float, default=None, metavar="DEG",
                    help="magnetic variation, east positive: the card adds magnetic headings")
     _add_design_arguments(p)
