@@ -68,3 +68,43 @@ def test_simulator_tracking_statistics_use_the_standard_law(high_plan):
     np.testing.assert_allclose(mps_to_kt(h["cas_mps"]), flown_kt, atol=0.01)
     # the auto-throttle holds the card's KCAS, not its equivalent airspeed (2.2 kt apart)
     assert tr.rms_cas_error_kt < 0.5 and abs(np.mean(error_kt)) < 0.1
+
+
+def _eas_law_plan(plan):
+    """The plan as the equivalent-airspeed law wrote it: same TAS, KCAS = sqrt(rho/rho0) TAS,
+    qc_pa = ½ rho0 KCAS²."""
+    import dataclasses
+
+    from pitotcal.core.units import RHO0_KGM3, isa_density_kgm3
+
+    eas = plan.tas_mps * np.sqrt(isa_density_kgm3(plan.alt_m) / RHO0_KGM3)
+    return dataclasses.replace(plan, cas_mps=eas, qc_pa=0.5 * RHO0_KGM3 * eas ** 2)
+
+
+def test_an_eas_law_plan_is_flown_at_its_kcas_as_cas_with_a_warning(high_plan):
+    from pitotcal.maneuvers.fly.simulator import references
+
+    from pitotcal.core.speeds import tas_from_cas_mps
+
+    old = _eas_law_plan(high_plan)
+    with pytest.warns(UserWarning, match=r"tas_mps differs by up to 2\.\d\d kt .* flying "
+                                         r"cas_mps as calibrated airspeed"):
+        refs = references(old, 5.0)
+    expected = np.interp(refs.time_s, old.time_s, tas_from_cas_mps(old.cas_mps, old.alt_m))
+    np.testing.assert_allclose(refs.tas_mps, expected, rtol=1e-12)
+    # 260 KEAS there is 262.2 KCAS: the old card's 260 flies 0.8 % slower in TAS now
+    assert refs.tas_mps[-1] / old.tas_mps[-1] == pytest.approx(0.9918, abs=0.0005)
+
+
+def test_an_eas_law_plan_at_t2_altitude_flies_without_a_warning():
+    import warnings
+
+    from pitotcal.maneuvers.fly.simulator import references
+
+    old = _eas_law_plan(plan_maneuver())
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        refs = references(old, 5.0)
+    # EAS and CAS differ by 0.008 kt at 800 ft and 100 kt
+    np.testing.assert_allclose(refs.tas_mps, np.interp(refs.time_s, old.time_s, old.tas_mps),
+                               rtol=2e-4)
