@@ -11,7 +11,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
-from bench_plan import _median, command_ratio
+from bench_plan import command_ratio
+from timing import median_result
 
 
 def main(argv=None):
@@ -30,7 +31,7 @@ def main(argv=None):
 
     rows = []
     noise = default_noise(0.5, 244.0, [44.0])
-    t, d = _median(lambda: design_schedule(
+    t, d = median_result(lambda: design_schedule(
         70.0, 100.0, 240.0, altitude_m=244.0, accel_max_mps2=1.0, dt_s=1.0,
         bank_max_rad=np.radians(30.0), radius_m=926.0, wind_ne_mps=wind_vector_mps(5, 270),
         noise=noise, coverage_rad=2 * np.pi + np.radians(15.0)), r)
@@ -40,12 +41,12 @@ def main(argv=None):
         planner._problem.cache_clear()
         return plan_maneuver(design="optimal")
 
-    t_cold, plan = _median(cold, r)
+    t_cold, plan = median_result(cold, r)
     rows.append(("default optimal plan, cold (design + OCP build + solve)", t_cold,
                  f"{plan.iterations} iterations, success={plan.success}"))
-    t, plan = _median(lambda: plan_maneuver(design="optimal"), r)
+    t, plan = median_result(lambda: plan_maneuver(design="optimal"), r)
     rows.append(("default optimal plan, warm", t, f"{plan.iterations} iterations"))
-    t, plan = _median(lambda: plan_maneuver(design="optimal",
+    t, plan = median_result(lambda: plan_maneuver(design="optimal",
                                             design_options={"target_2sigma_kt": 0.6}), r)
     rows.append(("optimal plan for target 0.6 kt", t, f"{plan.time_s[-1]:.0f} s flight"))
     t_plan, t_ref, ratio = command_ratio(r, ("--design", "optimal"))

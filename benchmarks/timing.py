@@ -13,3 +13,13 @@ def median_s(fun, repeats):
         fun()
         times.append(time.perf_counter() - start)
     return statistics.median(times)
+
+
+def median_result(fun, repeats):
+    """(median wall time of `repeats` calls of `fun()`, seconds; the last call's result)."""
+    times, out = [], None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        out = fun()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), out

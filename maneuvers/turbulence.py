@@ -1,4 +1,4 @@
-"""Dryden turbulence: MIL-F-8785C shaping filters built with python-control, run on whole arrays.
+"""Dryden turbulence: MIL-F-8785C shaping filters in plain numpy, run on whole arrays.
 
 The gust field is frozen and the aircraft flies through it at the mean true airspeed V, so a
 spatial spectrum with scale L becomes a temporal one with time constant L / V. Unit-intensity
@@ -31,10 +31,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from pitotcal.core.checks import integer, number, positive
+from pitotcal.core.linear import zoh_transfer_function
 from pitotcal.core.units import FT_TO_M
 
-__all__ = ["DrydenScales", "along_path_gust", "dryden_filters", "dryden_gusts", "dryden_scales",
-           "plunge_response"]
+__all__ = ["DrydenScales", "along_path_gust", "discrete_dryden_filters", "dryden_filters",
+           "dryden_gusts", "dryden_scales", "plunge_response"]
 
 _LOW_FT, _HIGH_FT = 1000.0, 2000.0
 _HIGH_SCALE_FT = 1750.0
@@ -108,7 +109,7 @@ def _white_noise(n, dt_s, scales, tas_mps, rng):
 
 
 def dryden_filters(scales, tas_mps):
-    """Continuous shaping filters (u, v, w) as python-control transfer functions.
+    """Continuous shaping filters (u, v, w) as transfer-function coefficients.
 
     Parameters
     ----------
@@ -118,29 +119,66 @@ def dryden_filters(scales, tas_mps):
 
     Returns
     -------
-    tuple of control.TransferFunction
-        H_u, H_v, H_w of the module Notes (input: white noise of spectral density pi).
+    tuple of (ndarray, ndarray)
+        (num, den) of H_u, H_v, H_w of the module Notes, polynomials in s with the highest
+        power first (input: white noise of spectral density pi); what ``control.tf(num, den)``
+        takes, for analysis with python-control.
     """
-    import control
-
     gain_u, t_u = _along_path_filter(scales, tas_mps)
     v = float(tas_mps)
     t_v, t_w = scales.length_v_m / v, scales.length_w_m / v
-    h_u = control.tf([gain_u], [t_u, 1.0])
+    h_u = (np.array([gain_u]), np.array([t_u, 1.0]))
 
     def lateral(sigma, tau):
         gain = sigma * np.sqrt(tau / np.pi)
-        return control.tf([gain * np.sqrt(3.0) * tau, gain], [tau * tau, 2.0 * tau, 1.0])
+        return np.array([gain * np.sqrt(3.0) * tau, gain]), np.array([tau * tau, 2.0 * tau, 1.0])
 
     return h_u, lateral(scales.sigma_v_mps, t_v), lateral(scales.sigma_w_mps, t_w)
+
+
+def discrete_dryden_filters(scales, tas_mps, dt_s):
+    """The shaping filters discretised with a zero-order hold at step `dt_s`.
+
+    Returns
+    -------
+    tuple of (ndarray, ndarray)
+        (num, den) in powers of z^-1 of H_u, H_v, H_w, as ``scipy.signal.lfilter`` takes them.
+
+    Notes
+    -----
+    `pitotcal.core.linear.zoh_transfer_function` of `dryden_filters`: what python-control's
+    ``c2d(tf(num, den), dt_s, method="zoh")`` computes (through scipy's `cont2discrete`), to
+    rounding, in plain numpy (importing scipy.signal costs `simulate` about 1 s on a busy
+    machine). Its leading zero dropped, the response leads the hold's by one sample: the same
+    gust process, since the input is white.
+    """
+    positive("dt_s", dt_s)
+    return tuple(zoh_transfer_function(num, den, dt_s)
+                 for num, den in dryden_filters(scales, tas_mps))
+
+
+def _filter(num, den, x):
+    """``scipy.signal.lfilter(num, den, x)`` for den[0] = 1 and at most second order, from rest:
+    y_k = b0 x_k + b1 x_(k-1) + b2 x_(k-2) - a1 y_(k-1) - a2 y_(k-2), a plain loop over floats."""
+    if len(num) > 3 or len(den) > 3:
+        raise ValueError("_filter runs filters of at most second order")
+    b0, b1, b2 = (*num, 0.0, 0.0, 0.0)[:3]
+    _, a1, a2 = (*den, 0.0, 0.0)[:3]
+    x1 = x2 = y1 = y2 = 0.0
+    out = []
+    for v in x.tolist():
+        y = b0 * v + b1 * x1 + b2 * x2 - a1 * y1 - a2 * y2
+        out.append(y)
+        x2, x1, y2, y1 = x1, v, y1, y
+    return np.array(out)
 
 
 def dryden_gusts(n, dt_s, scales, tas_mps, rng):
     """Gust time series (u, v, w) of `n` samples at step `dt_s`, stationary from the first sample.
 
-    Each filter is discretised with a zero-order hold (python-control `c2d`) and run over the
-    whole noise array with `scipy.signal.lfilter`; a burn-in of ten time constants is discarded
-    so the series starts in the stationary distribution rather than at zero.
+    Each filter is discretised with a zero-order hold (`discrete_dryden_filters`) and run over
+    the whole noise array; a burn-in of ten time constants is discarded so the series starts in
+    the stationary distribution rather than at zero.
 
     Parameters
     ----------
@@ -159,17 +197,10 @@ def dryden_gusts(n, dt_s, scales, tas_mps, rng):
     ndarray, shape (n, 3)
         Columns u (along the path), v (to the right), w (down), m/s.
     """
-    import control
-    from scipy.signal import lfilter
-
-    filters = dryden_filters(scales, tas_mps)
     burn, noise = _white_noise(n, dt_s, scales, tas_mps, rng)
     out = np.empty((n, 3))
-    for j, h in enumerate(filters):
-        hd = control.c2d(h, dt_s, method="zoh")
-        num = np.atleast_1d(np.squeeze(hd.num[0][0]))
-        den = np.atleast_1d(np.squeeze(hd.den[0][0]))
-        out[:, j] = lfilter(num, den, noise[j])[burn:]
+    for j, (num, den) in enumerate(discrete_dryden_filters(scales, tas_mps, dt_s)):
+        out[:, j] = _filter(num, den, noise[j])[burn:]
     return out
 
 
@@ -178,9 +209,8 @@ def along_path_gust(n, dt_s, scales, tas_mps, rng):
 
     The same noise draws and burn-in as `dryden_gusts`, and the same recursion its
     zero-order-hold filter runs (y_k = c x_k + a y_(k-1), a = exp(-dt / tau_u),
-    c = gain (1 - a)), with `a` and `c` in closed form instead of python-control's `c2d`: for
-    the plan command's auto-throttle check, which should not import python-control or
-    scipy.signal (1.7 s). The simulator keeps `dryden_gusts`, whose numbers its seeds pin.
+    c = gain (1 - a)), with `a` and `c` in closed form: the plan command's auto-throttle check
+    needs the along-path gust alone.
 
     Returns
     -------

@@ -3,21 +3,23 @@
 import numpy as np
 
 from pitotcal.core.plan import Plan
-from pitotcal.core.units import G0_MPS2, RHO0_KGM3, isa_density_kgm3, kt_to_mps
+from pitotcal.core.airdata import cas_from_qc_mps, qc_from_cas_pa
+from pitotcal.core.speeds import tas_from_qc_mps
+from pitotcal.core.units import G0_MPS2, kt_to_mps
 
 
 def circle_plan(duration_s=240.0, cas_kt=(70.0, 100.0), radius_m=600.0, altitude_m=244.0,
                 wind_speed_mps=5.0, wind_from_deg=270.0, step_s=0.5):
-    """A hand-made plan: a ground circle about the centre flown in the wind, CAS uniform in q.
+    """A hand-made plan: a ground circle about the centre flown in the wind, CAS uniform in q
+    (the standard CAS law and the isentropic q_c at the ISA altitude, as the planner writes).
 
     (Independent of the planner, so the simulator tests do not depend on it.)
     """
     t = np.arange(0.0, duration_s + 1e-9, step_s)
-    rho = float(isa_density_kgm3(altitude_m))
-    qlo, qhi = (0.5 * RHO0_KGM3 * kt_to_mps(v) ** 2 for v in cas_kt)
+    qlo, qhi = (float(qc_from_cas_pa(kt_to_mps(v))) for v in cas_kt)
     qc = qlo + (qhi - qlo) * t / duration_s
-    cas = np.sqrt(2 * qc / RHO0_KGM3)
-    tas = cas * np.sqrt(RHO0_KGM3 / rho)
+    cas = cas_from_qc_mps(qc)
+    tas = tas_from_qc_mps(qc, altitude_m)
     a = np.radians(wind_from_deg)
     w = np.array([-wind_speed_mps * np.cos(a), -wind_speed_mps * np.sin(a)])
 

@@ -5,7 +5,8 @@ Two tracking controllers fly the plan (maneuvers.fly.simulator prepares their re
 - lateral guidance (`guidance_law`): the plan's ground track becomes bank commands, limited
   in bank and roll rate;
 - the PI auto-throttle of maneuvers.plan.autothrottle (`autothrottle_law`): thrust on the plan's
-  airspeed schedule, through an engine lag, against quadratic drag;
+  airspeed schedule (the true airspeed of its KCAS by the standard law, `planned_tas_mps`),
+  through an engine lag, against quadratic drag;
 
 and a proportional altitude hold. `integrate_closed_loop` integrates pitotcal.core.dynamics.rhs
 with Heun's method, the controls and the wind held over each step.
@@ -16,19 +17,44 @@ call costs little more than the inlined code did.
 """
 
 import math
+import warnings
 
 import numpy as np
 
 from pitotcal.core.dynamics import rhs
-from pitotcal.core.units import G0_MPS2
+from pitotcal.core.errors import PitotcalError
+from pitotcal.core.speeds import tas_from_cas_mps
+from pitotcal.core.units import G0_MPS2, mps_to_kt
 
-__all__ = ["GUIDANCE_GAINS", "autothrottle_law", "guidance_law", "integrate_closed_loop"]
+__all__ = ["GUIDANCE_GAINS", "TAS_MISMATCH_WARN_KT", "autothrottle_law", "guidance_law",
+           "integrate_closed_loop", "planned_tas_mps"]
 
 # Lateral guidance: desired ground track = the path's direction + K_pos * distance to the path
 # (1/s); heading loop K_psi (1/s). K_pos is slow (time constant 20 s) so turbulence does not make
 # the bank busy; K_psi keeps a 10 deg heading error below a 20 deg bank correction at 45 m/s.
 # Altitude hold: climb = the plan's climb + K_alt * altitude error (1/s).
 GUIDANCE_GAINS = {"k_pos_per_s": 1.0 / 20.0, "k_psi_per_s": 0.4, "k_alt_per_s": 0.2}
+
+# A plan whose tas_mps differs more than this from the TAS of its cas_mps (standard law) was
+# written with another speed law (½ρ0 V² for KCAS, i.e. equivalent airspeed): say so.
+TAS_MISMATCH_WARN_KT = 0.05
+
+
+def planned_tas_mps(plan):
+    """The true airspeed of the plan's KCAS at its altitude, m/s (`core.speeds`), warning when
+    the plan's own tas_mps column disagrees by more than TAS_MISMATCH_WARN_KT."""
+    try:
+        tas = tas_from_cas_mps(plan.cas_mps, plan.alt_m)
+    except PitotcalError as exc:
+        raise PitotcalError(f"plan columns cas_mps, alt_m: {exc}") from None
+    worst_kt = float(mps_to_kt(np.max(np.abs(tas - plan.tas_mps))))
+    if worst_kt > TAS_MISMATCH_WARN_KT:
+        warnings.warn(
+            f"the plan's tas_mps differs by up to {worst_kt:.2f} kt from the true airspeed of "
+            "its cas_mps by the standard CAS law (a plan whose KCAS was equivalent airspeed): "
+            "flying cas_mps as calibrated airspeed; re-plan for consistent columns",
+            stacklevel=4)
+    return tas
 
 
 def guidance_law(refs, limits):

@@ -38,11 +38,11 @@ def first_order_lag(x, dt_s, tau_s):
     tau_s : float
         Time constant, s (0: no lag, `x` is returned).
     """
-    from scipy.signal import lfilter
-
     x = np.asarray(x, dtype=float)
     if tau_s <= 0 or x.size == 0:
         return x.copy()
+    from scipy.signal import lfilter                    # ~1 s to import: only with a lag
+
     a = np.exp(-dt_s / tau_s)
     y, _ = lfilter([1.0 - a], [1.0, -a], x, zi=[a * x[0]])
     return y

@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from .guidance import GUIDANCE_GAINS, integrate_closed_loop
+from .guidance import GUIDANCE_GAINS, integrate_closed_loop, planned_tas_mps
 from ..plan.autothrottle import tune_autothrottle
 from .sensors import (
     air_records,
@@ -44,9 +44,9 @@ from pitotcal.core.dynamics import Limits
 from pitotcal.core.flight import Flight
 from pitotcal.core.measurement import StaticAir, isa_air
 from pitotcal.core.models import get_model
+from pitotcal.core.speeds import cas_from_tas_mps
 from pitotcal.core.units import (
     G0_MPS2,
-    RHO0_KGM3,
     isa_density_kgm3,
     mps_to_kt,
     wind_polar,
@@ -86,7 +86,7 @@ class References:
     sample_time_s : ndarray (n,)
         Logged sample times.
     north_m, east_m, alt_m, heading_deg, bank_deg, tas_mps : ndarray (n_dyn,)
-        The plan's columns interpolated onto the grid.
+        The plan's columns on the grid; TAS that of its KCAS (`guidance.planned_tas_mps`).
     vn_mps, ve_mps, tas_rate_mps2, climb_mps : ndarray (n_dyn,)
         Ground velocity, TAS rate and climb rate of the plan, differentiated on its own nodes
         (smoother than the derivative of the interpolant), then interpolated.
@@ -156,15 +156,16 @@ def references(plan, rate_hz):
     def rate_on_grid(values):
         return on_grid(np.gradient(values, plan.time_s))
 
-    tas, bank = on_grid(plan.tas_mps), on_grid(plan.bank_deg)
+    tas_plan = planned_tas_mps(plan)
+    tas, bank = on_grid(tas_plan), on_grid(plan.bank_deg)
     return References(
         time_s=t_dyn, dt_s=dt_dyn, steps_per_sample=sub, sample_time_s=t0 + np.arange(n) * dt,
         north_m=on_grid(plan.north_m), east_m=on_grid(plan.east_m), alt_m=on_grid(plan.alt_m),
         heading_deg=on_grid(plan.heading_deg), bank_deg=bank, tas_mps=tas,
         vn_mps=rate_on_grid(plan.north_m), ve_mps=rate_on_grid(plan.east_m),
-        tas_rate_mps2=rate_on_grid(plan.tas_mps), climb_mps=rate_on_grid(plan.alt_m),
+        tas_rate_mps2=rate_on_grid(tas_plan), climb_mps=rate_on_grid(plan.alt_m),
         turn_rate_rps=G0_MPS2 * np.tan(np.radians(bank)) / tas,
-        tas_max_mps=float(plan.tas_mps.max()))
+        tas_max_mps=float(tas_plan.max()))
 
 
 def wind_field(plan, refs, opts, rng):
@@ -262,10 +263,10 @@ def _plunge(refs, wind, states, opts):
     return out, -wind.gust_w_mps[::sub]
 
 
-def _tracking(plan, refs, states, path_index, rho):
-    """How closely the states at the sample times followed the plan."""
+def _tracking(plan, refs, states, path_index):
+    """How closely the states at the sample times followed the plan (CAS: `core.speeds`)."""
     north, east, alt, _, tas, bank, _, _ = states.T
-    cas_err_kt = mps_to_kt(tas * np.sqrt(rho / RHO0_KGM3)
+    cas_err_kt = mps_to_kt(cas_from_tas_mps(tas, alt)
                            - np.interp(refs.sample_time_s, plan.time_s, plan.cas_mps))
     return Tracking(
         max_cas_error_kt=float(np.max(np.abs(cas_err_kt))),
@@ -282,7 +283,7 @@ def _history(plan, refs, wind, states, flight, qc, vel):
     north, east, alt, psi, tas, bank, wn, we = states.T
     t, sub = refs.sample_time_s, refs.steps_per_sample
     return {"time_s": t, "north_m": north, "east_m": east, "alt_m": alt, "heading_rad": psi,
-            "tas_mps": tas, "cas_mps": tas * np.sqrt(flight.rho_kgm3 / RHO0_KGM3),
+            "tas_mps": tas, "cas_mps": cas_from_tas_mps(tas, alt),
             "cas_ref_mps": np.interp(t, plan.time_s, plan.cas_mps), "bank_rad": bank,
             "wind_n_mps": wn, "wind_e_mps": we, "qc_pa": qc, "gps_true_mps": vel,
             "gust_mps": np.column_stack([wind.gust_u_mps, wind.gust_v_mps])[::sub]}
@@ -364,7 +365,7 @@ def simulate(plan, options=None, *, seed=0, **overrides):
     states, path_index = integrate_closed_loop(refs, wind, speed_loop, limits)
     states, w_up = _plunge(refs, wind, states, opts)
     flight, qc, vel = _record(refs.sample_time_s, states, opts, seed, rng_qc, rng_gps, w_up)
-    tracking = _tracking(plan, refs, states, path_index, flight.rho_kgm3)
+    tracking = _tracking(plan, refs, states, path_index)
     history = _history(plan, refs, wind, states, flight, qc, vel) if opts.keep_history else None
     return flight, _truth(plan, opts, seed, states, tracking, _loop_record(speed_loop), history)
 
@@ -382,7 +383,7 @@ def _jsbsim(plan, opts, seed, refs, limits):
     from .jsbsim_flight import fly_jsbsim
 
     flown = fly_jsbsim(plan, opts, seed, refs, limits)
-    tracking = _tracking(plan, refs, flown.states, flown.path_index, flown.flight.rho_kgm3)
+    tracking = _tracking(plan, refs, flown.states, flown.path_index)
     return flown.flight, _truth(plan, opts, seed, flown.states, tracking, flown.speed_loop,
                                 flown.history, options=flown.options, air_data="compressible")
 

@@ -15,7 +15,11 @@ _RADIUS_SLACK_M = 1.0
 
 @dataclass(frozen=True)
 class Tracking:
-    """How closely the simulated aircraft followed the plan (maxima over the record)."""
+    """How closely the simulated aircraft followed the plan (maxima over the record).
+
+    The CAS errors compare the calibrated airspeed flown, by the standard law at the altitude
+    flown (`pitotcal.core.speeds.cas_from_tas_mps`), with the plan's `cas_mps`: the card's KCAS.
+    """
 
     max_cas_error_kt: float
     rms_cas_error_kt: float

@@ -27,6 +27,8 @@ import numpy as np
 
 from pitotcal.core.checks import number, positive
 from pitotcal.core.dynamics import Limits
+from pitotcal.core.linear import expm
+from pitotcal.core.speeds import cas_from_tas_mps
 from pitotcal.core.units import G0_MPS2, mps_to_kt
 
 __all__ = [
@@ -210,20 +212,6 @@ class AutothrottleCheck:
                 f"({'within' if self.success else 'OUTSIDE'} +-{self.tolerance_kt:g} KCAS)")
 
 
-def _expm(m):
-    """exp(m) of a small matrix: Taylor series after scaling to norm <= 1/2, then squaring."""
-    norm = float(np.max(np.sum(np.abs(m), axis=0)))
-    squarings = math.ceil(math.log2(norm / 0.5)) if norm > 0.5 else 0
-    a = m / 2.0 ** squarings
-    out = term = np.eye(m.shape[0])
-    for k in range(1, 20):                      # |a| <= 1/2: the remainder is below 1e-24
-        term = term @ a / k
-        out = out + term
-    for _ in range(squarings):
-        out = out @ out
-    return out
-
-
 def _lsim_foh(a, b, c, d, dt_s, u):
     """Response from rest of x' = a x + b u, y = c x + d u to the inputs `u` (N, m) sampled
     every `dt_s` and linear in between: exact (python-control's `forced_response`)."""
@@ -231,7 +219,7 @@ def _lsim_foh(a, b, c, d, dt_s, u):
     block = np.zeros((n + 2 * m, n + 2 * m))
     block[:n, :n], block[:n, n:n + m] = a * dt_s, b * dt_s
     block[n:n + m, n + m:] = np.eye(m)
-    e = _expm(block)
+    e = expm(block)
     ad, bd1 = e[:n, :n], e[:n, n + m:]
     drive = u[:-1] @ (e[:n, n:n + m] - bd1).T + u[1:] @ bd1.T
     x = np.zeros((u.shape[0], n))
@@ -283,8 +271,8 @@ def check_autothrottle(plan, loop=None, *, turbulence_mps=0.0, turbulence_length
     -----
     The loop of `_closed_loop`, from rest, driven by the reference (through T = CP/(1+CP)),
     the feed-forward D(V_ref) + V_ref' (through P/(1+CP)) and the gust (through
-    -s/(s+X_u)/(1+CP)), each linear between the samples. CAS follows TAS at constant altitude
-    by the plan's CAS/TAS ratio.
+    -s/(s+X_u)/(1+CP)), each linear between the samples. CAS follows TAS by the standard law
+    at the plan's altitude (`pitotcal.core.speeds`).
     """
     from ..turbulence import along_path_gust, dryden_scales
 
@@ -292,7 +280,6 @@ def check_autothrottle(plan, loop=None, *, turbulence_mps=0.0, turbulence_length
     rate_hz = positive("rate_hz", rate_hz)
     t = np.arange(plan.time_s[0], plan.time_s[-1] + 0.5 / rate_hz, 1.0 / rate_hz)
     tas_ref = np.interp(t, plan.time_s, plan.tas_mps)
-    ratio = np.interp(t, plan.time_s, plan.cas_mps / plan.tas_mps)
     if loop is None:
         loop = tune_autothrottle(0.5 * (tas_ref.min() + tas_ref.max()))
     v0 = loop.trim_tas_mps
@@ -312,7 +299,8 @@ def check_autothrottle(plan, loop=None, *, turbulence_mps=0.0, turbulence_length
                     np.column_stack([ref - ref[0], ff - ff[0], gust]))
     tas = v0 + ref[0] + out[:, 0]
     thrust_cmd = loop.drag_mps2(v0) + ff[0] + out[:, 1]
-    cas_cmd, cas = tas_ref * ratio, tas * ratio
+    alt_m = np.interp(t, plan.time_s, plan.alt_m)
+    cas_cmd, cas = cas_from_tas_mps(tas_ref, alt_m), cas_from_tas_mps(tas, alt_m)
     err_kt = mps_to_kt(cas - cas_cmd)
     max_err = float(np.max(np.abs(err_kt)))
     return AutothrottleCheck(t, cas_cmd, cas, err_kt, max_err,

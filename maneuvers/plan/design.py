@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from .profiles import dwell_schedule
 
+from pitotcal.core.airdata import qc_from_cas_pa
 from pitotcal.core.errors import PlanInfeasibleError
 from pitotcal.core.information import (
     ResidualNoise,
@@ -35,7 +36,7 @@ from pitotcal.core.information import (
 )
 from pitotcal.core.models import get_model
 from pitotcal.core.scenario import true_k
-from pitotcal.core.units import G0_MPS2, incompressible_qc_pa, kt_to_mps
+from pitotcal.core.units import G0_MPS2, kt_to_mps
 
 __all__ = [
     "CRITERIA",
@@ -192,7 +193,7 @@ def design_schedule(cas_min_kt, cas_max_kt, duration_s, *, altitude_m, accel_max
     PlanInfeasibleError
         No candidate turns 360° at each end level in this duration.
     """
-    q_lo, q_hi = (float(incompressible_qc_pa(kt_to_mps(v))) for v in (cas_min_kt, cas_max_kt))
+    q_lo, q_hi = (float(qc_from_cas_pa(kt_to_mps(v))) for v in (cas_min_kt, cas_max_kt))
     levels = (q_lo, 0.5 * (q_lo + q_hi), q_hi)
     lo_kt, hi_kt = range_kt or (cas_min_kt, cas_max_kt)
     vi_kt = np.linspace(lo_kt, hi_kt, GRID_POINTS)

@@ -20,20 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
+from pitotcal.core.airdata import cas_from_qc_mps
 from pitotcal.core.checks import choice, number
 from pitotcal.core.errors import PlanInfeasibleError
 from pitotcal.core.geo import check_lat_lon
 from pitotcal.core.plan import Plan
 from pitotcal.core.scenario import CAS_TOLERANCE_KT
-from pitotcal.core.units import (
-    G0_MPS2,
-    incompressible_cas_mps,
-    incompressible_qc_pa,
-    mps_to_kt,
-    wind_vector_mps,
-)
-from .export_checks import check_exportable_turn, check_ground_clearance
-
+from pitotcal.core.speeds import cas_from_tas_mps, qc_from_tas_isa_pa, tas_from_cas_mps
+from pitotcal.core.units import G0_MPS2, mps_to_kt, wind_vector_mps
 from pitotcal.io.mission_files import (
     FRAME_GLOBAL,
     FRAME_GLOBAL_RELATIVE_ALT,
@@ -43,6 +37,8 @@ from pitotcal.io.mission_files import (
     write_qgc_plan,
     write_qgc_wpl,
 )
+
+from .export_checks import check_exportable_turn, check_ground_clearance
 
 __all__ = ["ALTITUDE_REFS", "AUTOPILOTS", "MIN_STEP_S", "Mission", "build_mission",
            "check_loiter", "export_mission", "loiter_plan", "mission_path", "speed_levels",
@@ -119,7 +115,7 @@ def _stepped_levels(plan):
         ends.append(plan.time_s[last])
         start = nxt
     bounds = [plan.time_s[0], *ends, plan.time_s[-1]]
-    return tuple(float(incompressible_cas_mps(q)) for q in levels), _whole_seconds(bounds), None
+    return tuple(float(cas_from_qc_mps(q)) for q in levels), _whole_seconds(bounds), None
 
 
 def _staircase(plan, n):
@@ -128,8 +124,8 @@ def _staircase(plan, n):
     t = plan.time_s
     bounds = np.linspace(t[0], t[-1], n + 1)
     q_mid = np.interp(0.5 * (bounds[1:] + bounds[:-1]), t, plan.qc_pa)
-    cas = incompressible_cas_mps(q_mid)
-    cas_edges = incompressible_cas_mps(np.interp(bounds, t, plan.qc_pa))
+    cas = cas_from_qc_mps(q_mid)
+    cas_edges = cas_from_qc_mps(np.interp(bounds, t, plan.qc_pa))
     error = np.maximum(np.abs(cas_edges[:-1] - cas), np.abs(cas_edges[1:] - cas))
     return cas, bounds, float(mps_to_kt(error.max()))
 
@@ -266,8 +262,8 @@ def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl",
         The test-area centre, degrees (WGS-84), latitude in [-90, 90], longitude in [-180, 180).
     altitude_ref : {"msl", "agl"}
         "msl": the loiters at the plan's altitude above mean sea level (MAV_FRAME_GLOBAL) - the
-        altitude whose ISA density the plan's true airspeeds use; "agl": the same number above
-        home (MAV_FRAME_GLOBAL_RELATIVE_ALT).
+        altitude whose ISA pressure and temperature the plan's true airspeeds use; "agl": the
+        same number above home (MAV_FRAME_GLOBAL_RELATIVE_ALT).
     ground_elevation_m : float, optional
         The ground at the centre, m above mean sea level: a loiter less than
         `MIN_CLEARANCE_M` above it is refused; without it an "msl" mission is a warning
@@ -366,11 +362,12 @@ def loiter_plan(plan, mission, *, start_deg=0.0):
     t = plan.time_s
     radius, sign = abs(mission.radius_m), math.copysign(1.0, mission.radius_m)
     wind_ne = tuple(float(w) for w in wind_vector_mps(s["wind_speed_mps"], s["wind_from_deg"]))
-    tas_per_cas = float(np.mean(plan.tas_mps / plan.cas_mps))
+    alt_m = float(np.mean(plan.alt_m))
     # the commanded level at each node, then the speed the autopilot reaches at accel_max
     edges = np.cumsum(mission.loiter_s)
-    level = np.asarray(mission.cas_mps)[np.minimum(np.searchsorted(edges, t, side="right"),
-                                                   len(edges) - 1)] * tas_per_cas
+    level = tas_from_cas_mps(
+        np.asarray(mission.cas_mps)[np.minimum(np.searchsorted(edges, t, side="right"),
+                                               len(edges) - 1)], alt_m)
     tas = np.empty_like(t)
     tas[0] = level[0]
     step = float(s.get("accel_max_mps2", 1.0)) * np.diff(t)
@@ -380,9 +377,9 @@ def loiter_plan(plan, mission, *, start_deg=0.0):
                                  math.radians(start_deg) + sign * np.pi / 2, sign)
     bearing = track - sign * np.pi / 2
     bank = np.arctan(tas * np.gradient(heading, t) / G0_MPS2)
-    cas = tas / tas_per_cas
+    cas = cas_from_tas_mps(tas, alt_m)
     return Plan(time_s=t.copy(), north_m=radius * np.cos(bearing),
                 east_m=radius * np.sin(bearing), alt_m=plan.alt_m.copy(),
                 heading_deg=np.degrees(heading), bank_deg=np.degrees(bank), tas_mps=tas,
-                cas_mps=cas, qc_pa=incompressible_qc_pa(cas), settings=dict(s),
+                cas_mps=cas, qc_pa=qc_from_tas_isa_pa(tas, alt_m), settings=dict(s),
                 message="loiter flown by an autopilot")

@@ -30,7 +30,8 @@ from .request import (
 
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import Plan
-from pitotcal.core.units import G0_MPS2, RHO0_KGM3, mps_to_kt, wind_vector_mps
+from pitotcal.core.speeds import cas_from_tas_mps
+from pitotcal.core.units import G0_MPS2, mps_to_kt, wind_vector_mps
 
 __all__ = ["MAX_ITER", "MAX_NODES", "ManeuverProblem", "PathSolution", "PlanRequest",
            "check_converged", "plan_maneuver", "turn_radius_m", "wind_vector_mps"]
@@ -154,7 +155,7 @@ def _solve(req, schedule, ipopt_options):
                    for runs in schedule.groups)
     r_turn = float(turn_radius_m(tas_turn, req.bank_max_rad))
     if req.radius_m < r_turn + req.margin_m:
-        cas_kt = float(mps_to_kt(tas_turn * np.sqrt(schedule.rho_kgm3 / RHO0_KGM3)))
+        cas_kt = float(mps_to_kt(cas_from_tas_mps(tas_turn, schedule.altitude_m)))
         message = (f"radius_m {req.radius_m:g} m is below the {np.ceil(r_turn + req.margin_m):.0f}"
                    f" m turn radius at {cas_kt:.0f} KCAS and {req.bank_max_deg:g}° bank")
         smallest = problem.solve(*args, minimize_radius=True, **kwargs)

@@ -9,6 +9,10 @@ Three profiles (paper section IV, Fig. 9):
   joined by ramps at the acceleration limit.
 - ``two-speed`` - the S-2 flight: a dwell at cas_min, one ramp, a dwell at cas_max.
 
+"KCAS" is calibrated airspeed by the standard law (`pitotcal.core.speeds`): q is the isentropic
+impact pressure of the true airspeed at the plan altitude's ISA p_s and T, CAS its
+airspeed-indicator reading, so a pilot's card and the plan's q_c agree at any altitude.
+
 The time grid is uniform inside each dwell and each ramp, with nodes exactly at every ramp
 start and end: docs/measured.md found q errors of ~30 Pa when a ramp corner falls between nodes.
 """
@@ -19,12 +23,9 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import PROFILES
-from pitotcal.core.units import (
-    RHO0_KGM3,
-    incompressible_cas_mps,
-    incompressible_qc_pa,
-    isa_density_kgm3,
-)
+from pitotcal.core.airdata import cas_from_qc_mps, qc_from_cas_pa
+from pitotcal.core.speeds import qc_from_tas_isa_pa, qc_slope_per_tas, tas_from_qc_mps
+from pitotcal.core.units import isa_density_kgm3
 
 __all__ = ["PROFILES", "Schedule", "coverage_groups", "dwell_schedule", "make_schedule"]
 
@@ -37,7 +38,8 @@ class Schedule:
     ----------
     profile : str
     time_s, cas_mps, tas_mps, qc_pa : ndarray (N + 1,)
-        Node times and the target airspeeds / impact pressure at each node.
+        Node times and the target airspeeds / impact pressure at each node: CAS by the
+        standard law, TAS and the isentropic q_c at the plan altitude (`core.speeds`).
     accel_mps2 : ndarray (N,)
         True-airspeed acceleration on each interval; TAS is linear inside an interval, so the
         point-mass model reproduces the node speeds exactly.
@@ -47,7 +49,9 @@ class Schedule:
     levels_qc_pa : tuple of float
         Dwell levels (step-pause, two-speed); empty for continuous.
     rho_kgm3 : float
-        ISA density at the plan altitude (TAS = CAS sqrt(rho0 / rho)).
+        ISA density at the plan altitude.
+    altitude_m : float
+        The plan altitude, where TAS and q_c convert.
     """
 
     profile: str
@@ -59,6 +63,7 @@ class Schedule:
     groups: tuple
     levels_qc_pa: tuple
     rho_kgm3: float
+    altitude_m: float
 
     @property
     def n_intervals(self):
@@ -108,14 +113,14 @@ def _segment_grid(durations, dt_s):
     return np.asarray(times), counts
 
 
-def _continuous_q(q_range, cas_min_mps, duration_s, tas_per_cas, accel_max_mps2, dt_s,
-                  return_leg):
+def _continuous_q(q_range, altitude_m, duration_s, accel_max_mps2, dt_s, return_leg):
     """Node times and q of the continuous profile: q linear in time (up, or up and down)."""
     q_min, q_max = q_range
     legs = 2 if return_leg else 1
-    # the steepest TAS acceleration of a uniform-q ramp is at the slowest speed:
-    # dV/dt = (dq/dt) / (rho0 V_cas) * sqrt(rho0/rho)
-    need_s = legs * (q_max - q_min) * tas_per_cas / (RHO0_KGM3 * cas_min_mps * accel_max_mps2)
+    # dq_c/dV_t grows with V_t, so a uniform-q ramp accelerates hardest at the slowest speed:
+    # dV_t/dt = (dq/dt) / (dq_c/dV_t)
+    slope = float(qc_slope_per_tas(tas_from_qc_mps(q_min, altitude_m), altitude_m))
+    need_s = legs * (q_max - q_min) / (slope * accel_max_mps2)
     if duration_s < need_s:
         raise PlanInfeasibleError(
             f"duration_s {duration_s:g} s is too short for the {accel_max_mps2:g} m/s^2 "
@@ -128,7 +133,7 @@ def _continuous_q(q_range, cas_min_mps, duration_s, tas_per_cas, accel_max_mps2,
     return time_s, q_min + (q_max - q_min) * frac
 
 
-def _stepped_q(q_range, levels, duration_s, tas_per_cas, accel_max_mps2, dt_s):
+def _stepped_q(q_range, levels, duration_s, altitude_m, accel_max_mps2, dt_s):
     """Node times, q and the levels of a stepped profile: equal dwells at levels equally
     spaced in q, joined by ramps at the acceleration limit (TAS linear in time)."""
     q_min, q_max = q_range
@@ -136,17 +141,17 @@ def _stepped_q(q_range, levels, duration_s, tas_per_cas, accel_max_mps2, dt_s):
     if n_levels < 2:
         raise PitotcalError(f"levels {levels} must be at least 2", param="levels")
     level_q = q_min + (q_max - q_min) * np.arange(n_levels) / (n_levels - 1)
-    return _dwell_q(level_q, np.full(n_levels, 1.0 / n_levels), duration_s, tas_per_cas,
+    return _dwell_q(level_q, np.full(n_levels, 1.0 / n_levels), duration_s, altitude_m,
                     accel_max_mps2, dt_s)
 
 
-def _dwell_q(level_q, fractions, duration_s, tas_per_cas, accel_max_mps2, dt_s):
+def _dwell_q(level_q, fractions, duration_s, altitude_m, accel_max_mps2, dt_s):
     """Node times, q and the levels of dwells at `level_q` (in flying order, repeats allowed)
     sharing the time the ramps leave in proportion to `fractions`, joined by ramps at the
     acceleration limit (TAS linear in time)."""
     level_q = np.asarray(level_q, dtype=float)
     n_levels = level_q.size
-    level_tas = incompressible_cas_mps(level_q) * tas_per_cas
+    level_tas = tas_from_qc_mps(level_q, altitude_m)
     ramps = np.abs(np.diff(level_tas)) / accel_max_mps2
     dwells = (duration_s - ramps.sum()) * np.asarray(fractions, dtype=float) / np.sum(fractions)
     # a dwell shorter than one node spacing is no dwell at all
@@ -169,7 +174,7 @@ def _dwell_q(level_q, fractions, duration_s, tas_per_cas, accel_max_mps2, dt_s):
             qc[node:node + count] = level_q[seg]
         else:                    # ramp: TAS linear in time at the acceleration limit
             tas = np.linspace(level_tas[seg], level_tas[seg + 1], count + 1)[1:]
-            qc[node:node + count] = incompressible_qc_pa(tas / tas_per_cas)
+            qc[node:node + count] = qc_from_tas_isa_pa(tas, altitude_m)
         node += count
     return time_s, qc, tuple(float(v) for v in level_q)
 
@@ -198,17 +203,20 @@ def dwell_schedule(level_q, fractions, duration_s, *, altitude_m, accel_max_mps2
     Schedule
         ``levels_qc_pa`` is the flying order of the dwells.
     """
-    rho = float(isa_density_kgm3(altitude_m))
-    tas_per_cas = np.sqrt(RHO0_KGM3 / rho)
-    time_s, qc, level_q = _dwell_q(level_q, fractions, duration_s, tas_per_cas,
+    time_s, qc, level_q = _dwell_q(level_q, fractions, duration_s, altitude_m,
                                    accel_max_mps2, dt_s)
     covered = (min(level_q), max(level_q)) if covered is None else covered
     groups = tuple(_runs(np.isclose(qc, q, rtol=1e-9, atol=1e-6)) for q in covered)
-    cas = incompressible_cas_mps(qc)
-    tas = cas * tas_per_cas
-    return Schedule(profile=profile, time_s=time_s, cas_mps=cas, tas_mps=tas, qc_pa=qc,
-                    accel_mps2=np.diff(tas) / np.diff(time_s), groups=groups,
-                    levels_qc_pa=level_q, rho_kgm3=rho)
+    return _schedule(profile, time_s, qc, groups, level_q, altitude_m)
+
+
+def _schedule(profile, time_s, qc, groups, level_q, altitude_m):
+    """The `Schedule` of node times and q: CAS by the standard law, TAS at the altitude."""
+    tas = tas_from_qc_mps(qc, altitude_m)
+    return Schedule(profile=profile, time_s=time_s, cas_mps=cas_from_qc_mps(qc), tas_mps=tas,
+                    qc_pa=qc, accel_mps2=np.diff(tas) / np.diff(time_s), groups=groups,
+                    levels_qc_pa=level_q, rho_kgm3=float(isa_density_kgm3(altitude_m)),
+                    altitude_m=float(altitude_m))
 
 
 def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
@@ -223,7 +231,7 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
     duration_s : float
         Total maneuver time, s.
     altitude_m : float
-        Plan altitude; ISA density there converts CAS to TAS.
+        Plan altitude; the ISA p_s and T there convert CAS to TAS (`core.speeds`).
     accel_max_mps2 : float
         Acceleration limit; step-pause ramps fly at exactly this value.
     dt_s : float
@@ -245,7 +253,8 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
 
     Notes
     -----
-    Continuous: q(t) = q_min + (q_max - q_min) t / T, CAS = sqrt(2 q / rho0). Step-pause: level
+    Continuous: q(t) = q_min + (q_max - q_min) t / T, CAS = a0 sqrt(5 [(q/p0 + 1)^(2/7) - 1])
+    (`core.airdata.cas_from_qc_mps`). Step-pause: level
     i has q_i = q_min + i (q_max - q_min) / (levels - 1); each ramp takes
     (V_{i+1} - V_i) / accel_max (TAS) and the dwells share the rest of the duration equally.
 
@@ -258,19 +267,14 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
     if profile not in PROFILES:
         raise PitotcalError(f"profile {profile!r} is not one of {', '.join(PROFILES)}",
                             param="profile")
-    rho = float(isa_density_kgm3(altitude_m))
-    tas_per_cas = np.sqrt(RHO0_KGM3 / rho)
-    q_range = (float(incompressible_qc_pa(cas_min_mps)), float(incompressible_qc_pa(cas_max_mps)))
+    q_range = (float(qc_from_cas_pa(cas_min_mps)), float(qc_from_cas_pa(cas_max_mps)))
     if profile == "continuous":
-        time_s, qc = _continuous_q(q_range, cas_min_mps, duration_s, tas_per_cas,
-                                   accel_max_mps2, dt_s, return_leg)
+        time_s, qc = _continuous_q(q_range, altitude_m, duration_s, accel_max_mps2, dt_s,
+                                   return_leg)
         level_q = ()
     else:
         time_s, qc, level_q = _stepped_q(q_range, 2 if profile == "two-speed" else levels,
-                                         duration_s, tas_per_cas, accel_max_mps2, dt_s)
-    cas = incompressible_cas_mps(qc)
-    tas = cas * tas_per_cas
-    accel = np.diff(tas) / np.diff(time_s)
+                                         duration_s, altitude_m, accel_max_mps2, dt_s)
     if len(level_q) == 2:
         # S-2 style (two-speed, or step-pause with 2 levels): the middle third of the q range
         # is only the ramp, whose length no duration changes; cover each dwell instead
@@ -278,5 +282,4 @@ def make_schedule(profile, cas_min_mps, cas_max_mps, duration_s, *, altitude_m,
                        + _runs(np.isclose(qc, level_q[-1]))[-1:])
     else:
         groups = coverage_groups(qc)
-    return Schedule(profile=profile, time_s=time_s, cas_mps=cas, tas_mps=tas, qc_pa=qc,
-                    accel_mps2=accel, groups=groups, levels_qc_pa=level_q, rho_kgm3=rho)
+    return _schedule(profile, time_s, qc, groups, level_q, altitude_m)

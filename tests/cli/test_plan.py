@@ -181,7 +181,7 @@ def test_export_refuses_the_downwind_bank(tmp_path, capsys):
                  "--export", "ardupilot", "--no-figures", "-o", str(tmp_path / "p.csv")]) == 2
     assert capsys.readouterr().err == (
         "pitotcal plan: --radius-m 560 m is too small for a loiter: circling it downwind at "
-        "57.1 m/s ground speed (101 KTAS in 5 m/s wind) banks 31°, over --bank-max-deg 30°: "
+        "57.0 m/s ground speed (101 KTAS in 5 m/s wind) banks 31°, over --bank-max-deg 30°: "
         "export a plan with --radius-m at least 575 m\n")
     assert list(tmp_path.iterdir()) == []
 
@@ -247,7 +247,13 @@ def test_calibration_gives_kias_targets_that_the_correction_maps_back(tmp_path):
     kcas = np.array([float(r[1].split("±")[0]) for r in rows])
     kias = np.array([float(r[2]) for r in rows])
     back = kias + delta_v_kt(get_model("inverse"), (0.02, -15.0), kias)
-    np.testing.assert_allclose(back, kcas, atol=0.051)      # one decimal on the card
+    # one decimal on the KIAS column (and on the KCAS of a ramp row, whose target is not a
+    # whole level); an incompressible calibration's V_c is the equivalent airspeed, within
+    # 0.01 kt of the CAS at 244 m
+    level = np.isin(kcas, (70.0, 100.0))
+    assert level.sum() >= len(rows) - 2
+    np.testing.assert_allclose(back[level], kcas[level], atol=0.061)
+    np.testing.assert_allclose(back[~level], kcas[~level], atol=0.111)
     # dp/qc = 0.02 - 15/q_ci > 0 at 100 KCAS: the indicator reads low there (ΔV +0.5 kt)
     assert kias[-1] < kcas[-1] - 0.3
     bad = tmp_path / "bad.json"

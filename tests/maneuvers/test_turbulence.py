@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from pitotcal.maneuvers.turbulence import (
     along_path_gust,
+    discrete_dryden_filters,
     dryden_filters,
     dryden_gusts,
     dryden_scales,
@@ -46,11 +47,91 @@ def test_bad_scales_refused(args, match):
         dryden_scales(*args)
 
 
-def test_filters_are_python_control_with_spec_dc_gain():
+def test_filters_have_the_spec_dc_gain():
     s = dryden_scales(244.0, 0.5)
-    h_u, h_v, _ = dryden_filters(s, TAS)
-    assert float(np.real(h_u.dcgain())) == pytest.approx(0.5 * np.sqrt(2 * s.length_u_m / (np.pi * TAS)))
-    assert float(np.real(h_v.dcgain())) == pytest.approx(0.5 * np.sqrt(s.length_v_m / (np.pi * TAS)))
+    (num_u, den_u), (num_v, den_v), _ = dryden_filters(s, TAS)
+    assert num_u[-1] / den_u[-1] == pytest.approx(0.5 * np.sqrt(2 * s.length_u_m / (np.pi * TAS)))
+    assert num_v[-1] / den_v[-1] == pytest.approx(0.5 * np.sqrt(s.length_v_m / (np.pi * TAS)))
+
+
+CASES = [(244.0, 0.5, 40.0, 0.02), (244.0, 1.5, 52.0, 0.1), (30.0, 0.8, 36.0, 0.2),
+         (3048.0, 1.0, 150.0, 0.02)]
+
+
+@pytest.mark.parametrize("alt_m, sigma, tas, dt", CASES)
+def test_discrete_filters_match_python_control(alt_m, sigma, tas, dt):
+    """The zero-order-hold coefficients are python-control's c2d of its tf, to 1e-12."""
+    import control
+
+    s = dryden_scales(alt_m, sigma)
+    for (num, den), (numd, dend) in zip(dryden_filters(s, tas),
+                                        discrete_dryden_filters(s, tas, dt)):
+        hd = control.c2d(control.tf(num, den), dt, method="zoh")
+        ref_num = np.atleast_1d(np.squeeze(hd.num[0][0]))
+        ref_den = np.atleast_1d(np.squeeze(hd.den[0][0]))
+        assert numd.shape == ref_num.shape and dend.shape == ref_den.shape
+        np.testing.assert_allclose(numd, ref_num, rtol=1e-12, atol=1e-15)
+        np.testing.assert_allclose(dend, ref_den, rtol=1e-12, atol=1e-15)
+
+
+def _gusts_with_python_control(n, dt, s, tas, rng):
+    """The gust series by python-control's c2d, as the simulator made it with python-control."""
+    import control
+    from scipy.signal import lfilter
+
+    tau = max(s.length_u_m, s.length_v_m, s.length_w_m) / tas
+    burn = int(np.ceil(10.0 * tau / dt))
+    noise = rng.standard_normal((3, burn + n)) * np.sqrt(np.pi / dt)
+    out = np.empty((n, 3))
+    for j, (num, den) in enumerate(dryden_filters(s, tas)):
+        hd = control.c2d(control.tf(num, den), dt, method="zoh")
+        out[:, j] = lfilter(np.atleast_1d(np.squeeze(hd.num[0][0])),
+                            np.atleast_1d(np.squeeze(hd.den[0][0])), noise[j])[burn:]
+    return out
+
+
+def test_filter_is_lfilter():
+    from scipy.signal import lfilter
+
+    from pitotcal.maneuvers.turbulence import _filter
+
+    x = np.random.default_rng(3).standard_normal(2000)
+    for num, den in (([0.2], [1.0, -0.9]), ([0.02, -0.019], [1.0, -1.98, 0.9802])):
+        np.testing.assert_allclose(_filter(num, den, x), lfilter(num, den, x), rtol=0,
+                                   atol=1e-12)
+
+
+@pytest.mark.parametrize("alt_m, sigma, tas, dt", CASES)
+def test_gusts_match_python_control(alt_m, sigma, tas, dt):
+    s = dryden_scales(alt_m, sigma)
+    mine = dryden_gusts(5000, dt, s, tas, np.random.default_rng(11))
+    ref = _gusts_with_python_control(5000, dt, s, tas, np.random.default_rng(11))
+    np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-9 * sigma)
+    # and the statistics that follow from them
+    np.testing.assert_allclose(mine.std(axis=0), ref.std(axis=0), rtol=1e-9)
+
+
+def test_simulate_does_not_import_python_control(tmp_path):
+    """`pitotcal simulate` end to end in a fresh interpreter: neither python-control nor
+    scipy.signal loads."""
+    import subprocess
+    import sys
+
+    from plans import circle_plan
+
+    from pitotcal.io.plan_csv import write_plan
+
+    plan_csv = write_plan(circle_plan(duration_s=30.0), tmp_path / "plan.csv")
+    code = ("import sys\n"
+            "from pitotcal.cli import main\n"
+            f"status = main(['simulate', {str(plan_csv)!r}, '-o', {str(tmp_path / 'f.csv')!r}])\n"
+            "assert status == 0, status\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'control'\n"
+            "             or m.startswith('scipy.signal')))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env={**__import__("os").environ, "MPLBACKEND": "Agg"})
+    assert out.stdout.strip().splitlines()[-1] == "[]"
+    assert (tmp_path / "f.csv").exists()
 
 
 @pytest.fixture(scope="module")

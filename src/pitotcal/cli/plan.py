@@ -51,7 +51,8 @@ def add_parser(subparsers):
                         "(QGroundControl, PX4); needs --center")
     p.add_argument("--altitude-ref", choices=("msl", "agl"), default=None,
                    help="what --altitude-m is measured from on the card and in the mission "
-                        "(default: msl, the altitude whose ISA density gives the TAS)")
+                        "(default: msl, the altitude whose ISA pressure and temperature give "
+                        "the TAS)")
     p.add_argument("--ground-elevation-m", type=float, default=None, metavar="M",
                    help="with --export: the ground's elevation at --center, m above mean sea "
                         f"level; a loiter less than {MIN_CLEARANCE_M:g} m above it is refused "

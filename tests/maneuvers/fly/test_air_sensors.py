@@ -19,9 +19,10 @@ from pitotcal.core.moist_air import moist_density_kgm3, virtual_temperature_k
 from pitotcal.core.units import isa_pressure_pa, isa_temperature_k
 from pitotcal.io import read_flight, write_flight_csv
 
-# sha256 of today's default files (main before issue 9's sensors): seed 7, 60 s circle, 10 Hz
-GOLDEN_CSV = "6cc0e610abb5d3ba1aea46db4f6e503b03ba2332aab5fdfe870a14feaccbca52"
-GOLDEN_TRUTH = "675556d112a3e83e9bf71edfb96490e7fb6d3f18e7ef612b7587c42d998bd8cd"
+# sha256 of the default files without air sensors: seed 7, 60 s circle, 10 Hz (the plan's KCAS
+# by the standard CAS law, flown as calibrated airspeed)
+GOLDEN_CSV = "220766c82834503d6a3059b57f7efe65dcf0b06b15e33a751887d8589b910e15"
+GOLDEN_TRUTH = "bd985f3d59af8d71288939734781f4c624489dfdb7c89f2d2cf499573bc400ce"
 
 
 def _sha(path):

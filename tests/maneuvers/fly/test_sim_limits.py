@@ -100,6 +100,6 @@ def test_a_pressure_error_beyond_half_of_qc_is_refused_naming_the_flags(tmp_path
     err = capsys.readouterr().err
     assert status == 2 and err.count("\n") == 1
     assert err.startswith("pitotcal simulate: --k1 0.02, --k2 -1e+06: the inverse pressure error "
-                          "dp/qc reaches 1.26e+03 on the plan's q_c 794-")
+                          "dp/qc reaches 1.26e+03 on the plan's q_c 797-")
     flight, _ = simulate(circle_plan(duration_s=30.0), k=(0.3, -100.0), rate_hz=5.0)
     assert flight.qci_pa.min() > 0

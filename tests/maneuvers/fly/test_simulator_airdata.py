@@ -27,7 +27,7 @@ VI_KT = np.array([185.0, 200.0, 220.0, 240.0, 255.0])  # V_i = sqrt(2 q_ci / rho
 
 @pytest.fixture(scope="module")
 def fast_plan():
-    # 180-260 kt (the plan's CAS is sqrt(rho/rho0) V_t), 4.5 km circle: bank <= 30 deg
+    # 180-260 KCAS (standard law), 4.5 km circle: bank <= 30 deg
     return circle_plan(duration_s=240.0, cas_kt=(180.0, 260.0), radius_m=4500.0,
                        altitude_m=ALT_M, wind_speed_mps=5.0)
 

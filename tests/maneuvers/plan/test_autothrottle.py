@@ -13,13 +13,14 @@ from plans import circle_plan
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.plan import Plan
-from pitotcal.core.units import RHO0_KGM3, isa_density_kgm3, kt_to_mps
+from pitotcal.core.airdata import qc_from_cas_pa
+from pitotcal.core.speeds import cas_from_tas_mps, tas_from_cas_mps
+from pitotcal.core.units import kt_to_mps
 
 
 def step_pause_plan(levels_kt=(70.0, 80.0, 90.0, 100.0), dwell_s=50.0, accel_mps2=1.0,
                     altitude_m=244.0, step_s=0.5):
     """A CAS schedule only (the lateral columns are unused by the speed loop)."""
-    rho = float(isa_density_kgm3(altitude_m))
     cas = [kt_to_mps(levels_kt[0])] * int(dwell_s / step_s)
     for v in levels_kt[1:]:
         target = kt_to_mps(v)
@@ -30,8 +31,8 @@ def step_pause_plan(levels_kt=(70.0, 80.0, 90.0, 100.0), dwell_s=50.0, accel_mps
     t = np.arange(cas.size) * step_s
     zeros = np.zeros(t.size)
     return Plan(time_s=t, north_m=zeros, east_m=zeros, alt_m=zeros + altitude_m,
-                heading_deg=zeros, bank_deg=zeros, tas_mps=cas * np.sqrt(RHO0_KGM3 / rho),
-                cas_mps=cas, qc_pa=0.5 * RHO0_KGM3 * cas ** 2)
+                heading_deg=zeros, bank_deg=zeros, tas_mps=tas_from_cas_mps(cas, altitude_m),
+                cas_mps=cas, qc_pa=qc_from_cas_pa(cas))
 
 
 def test_tuning_meets_phase_margin_and_is_stable():
@@ -125,7 +126,6 @@ def _check_with_python_control(plan, turbulence_mps, seed, rate_hz=10.0):
 
     t = np.arange(plan.time_s[0], plan.time_s[-1] + 0.5 / rate_hz, 1.0 / rate_hz)
     tas_ref = np.interp(t, plan.time_s, plan.tas_mps)
-    ratio = np.interp(t, plan.time_s, plan.cas_mps / plan.tas_mps)
     loop = tune_autothrottle(0.5 * (tas_ref.min() + tas_ref.max()))
     v0, x_u = loop.trim_tas_mps, loop.drag_slope_per_s
     plant = speed_plant(v0, loop.engine_lag_s, loop.lift_to_drag)
@@ -142,7 +142,8 @@ def _check_with_python_control(plan, turbulence_mps, seed, rate_hz=10.0):
                             np.random.default_rng(seed))[:, 0]
         dv = dv + control.forced_response(control.tf([-1.0, 0.0], [1.0, x_u]) * sens, t,
                                           gust).outputs
-    return (v0 + dv) * ratio
+    # CAS by the standard law at the plan's altitude, as the check converts
+    return cas_from_tas_mps(v0 + dv, np.interp(t, plan.time_s, plan.alt_m))
 
 
 @pytest.mark.parametrize("turbulence, seed", [(0.0, 0), (0.5, 0), (1.5, 3)])

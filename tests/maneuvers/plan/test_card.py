@@ -6,15 +6,20 @@ from pitotcal.maneuvers.plan.card import draw_track_sketch, kias_targets
 
 from pitotcal.core.models import delta_v_kt, get_model
 from pitotcal.core.plan import Plan
-from pitotcal.core.units import FT_TO_M, incompressible_qc_pa, kt_to_mps, mps_to_kt
+from pitotcal.core.airdata import qc_from_cas_pa
+from pitotcal.core.speeds import tas_from_cas_mps
+from pitotcal.core.units import FT_TO_M, RHO0_KGM3, isa_density_kgm3, kt_to_mps, mps_to_kt
+
+ALT_M = 244.0
 
 
 def _plan(settings):
     t = np.linspace(0.0, 100.0, 101)
     psi = t / 20.0
     cas = kt_to_mps(np.linspace(70.0, 100.0, t.size))
-    return Plan(t, 500.0 * np.cos(psi), 500.0 * np.sin(psi), np.full(t.size, 244.0), psi,
-                np.full(t.size, 20.0), cas, cas, incompressible_qc_pa(cas), settings=settings)
+    return Plan(t, 500.0 * np.cos(psi), 500.0 * np.sin(psi), np.full(t.size, ALT_M), psi,
+                np.full(t.size, 20.0), tas_from_cas_mps(cas, ALT_M), cas, qc_from_cas_pa(cas),
+                settings=settings)
 
 
 def test_sketch_draws_the_circle_and_the_track_in_kft():
@@ -34,7 +39,11 @@ def test_kias_targets_are_corrected_back_to_the_kcas():
     plan = _plan({"calibration": {"model": "linear", "k": [0.03, -1e-5]}})
     kias = kias_targets(plan)
     back = kias + delta_v_kt(get_model("linear"), (0.03, -1e-5), kias)
-    np.testing.assert_allclose(back, mps_to_kt(plan.cas_mps), atol=1e-6)
+    # an incompressible calibration's V_c is sqrt(2 q_c / rho0) with q_c = ½ρV_t²: the
+    # equivalent airspeed of the target's TAS, within 0.01 kt of its CAS at 800 ft
+    eas_kt = mps_to_kt(plan.tas_mps * np.sqrt(isa_density_kgm3(ALT_M) / RHO0_KGM3))
+    np.testing.assert_allclose(back, eas_kt, atol=1e-6)
+    np.testing.assert_allclose(back, mps_to_kt(plan.cas_mps), atol=0.01)
     assert kias_targets(_plan({})) is None
 
 

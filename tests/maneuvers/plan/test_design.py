@@ -94,8 +94,8 @@ def test_mission_levels_of_a_designed_schedule_in_flying_order():
     from pitotcal.maneuvers.plan.missions import speed_levels
     from pitotcal.maneuvers.plan.profiles import dwell_schedule
 
+    from pitotcal.core.airdata import cas_from_qc_mps
     from pitotcal.core.plan import Plan
-    from pitotcal.core.units import incompressible_cas_mps
 
     q = [794.29, 1207.645, 1621.0, 794.29, 1621.0]
     s = dwell_schedule(q, [0.3, 0.1, 0.2, 0.2, 0.2], 300.0, altitude_m=244.0)
@@ -103,7 +103,7 @@ def test_mission_levels_of_a_designed_schedule_in_flying_order():
     plan = Plan(s.time_s, zeros, zeros, zeros + 244.0, zeros, zeros, s.tas_mps, s.cas_mps,
                 s.qc_pa, settings={"levels_qc_pa": q})
     cas, loiter_s, stair = speed_levels(plan)
-    np.testing.assert_allclose(cas, incompressible_cas_mps(np.array(q)))
+    np.testing.assert_allclose(cas, cas_from_qc_mps(np.array(q)))
     assert sum(loiter_s) == 300 and stair is None
     # the first dwell (low) lasts 0.3 of the dwell time; each ramp belongs to the level after
     assert loiter_s[0] == round(0.3 * (300.0 - _ramp_time(s)))
@@ -129,13 +129,13 @@ def test_average_criterion_lowers_the_mean_not_the_worst(optimal):
 def test_optimal_plan_exports_its_dwells_in_flying_order():
     from pitotcal.maneuvers.plan.missions import build_mission
 
-    from pitotcal.core.units import incompressible_cas_mps
+    from pitotcal.core.airdata import cas_from_qc_mps
 
     plan = plan_maneuver(design="optimal", radius_m=600.0, duration_s=300.0)
     mission = build_mission(plan, 47.39774, 8.54559)
     levels = plan.settings["levels_qc_pa"]
     assert len(mission.items) == 2 * len(levels) and sum(mission.loiter_s) == 300
-    np.testing.assert_allclose(mission.cas_mps, incompressible_cas_mps(np.array(levels)), rtol=1e-6)
+    np.testing.assert_allclose(mission.cas_mps, cas_from_qc_mps(np.array(levels)), rtol=1e-6)
     speeds = [item.params[1] for item in mission.items[::2]]
     np.testing.assert_allclose(speeds, mission.cas_mps)
 

@@ -168,7 +168,7 @@ INFEASIBLE = [
     ({"radius_m": 200, "bank_max_deg": 45},
      r"radius_m 200 m is below the 23\d m turn radius at 91 KCAS and 45° bank"),
     ({"duration_s": 10}, r"duration_s 10 s is too short for the 1 m/s\^2 acceleration limit: "
-                         r"needs at least 19 s"),
+                         r"needs at least 20 s"),
     ({"profile": "step-pause", "duration_s": 15}, r"too short for 4 levels .* needs at least"),
     ({"duration_s": 60}, r"duration_s 60 s is too short to turn 360° in each third of the q "
                          r"range at 30° bank: needs at least 17\d s"),
