@@ -163,3 +163,19 @@ def test_a_command_never_imports_another_command(graph):
     assert "pitotcal.cli.common" in graph["pitotcal.cli.identify"]
     assert {n: sorted(graph[n] & commands) for n in commands if graph[n] & commands} == {}
 
+
+
+def test_the_readme_layout_names_every_topic_folder():
+    """The README's layout table names each topic folder of the mapped layers as `name/`."""
+    readme = Path(__file__).resolve().parents[1] / "README.md"
+    if not readme.exists():
+        pytest.skip(f"no README.md beside tests/ ({readme})")
+    table = "\n".join(line for line in readme.read_text(encoding="utf-8").splitlines()
+                      if line.lstrip().startswith("| "))
+    missing = []
+    for layer in SUBLAYERS:
+        folder = Path(importlib.util.find_spec(layer).origin).parent
+        for sub in sorted(p.name for p in folder.iterdir() if (p / "__init__.py").exists()):
+            if f"`{sub}/`" not in table:
+                missing.append(f"{layer}.{sub}")
+    assert missing == []
