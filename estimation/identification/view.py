@@ -40,9 +40,7 @@ def _compressible(result):
 def airspeed_kt(result, qc_pa):
     """The airspeed of impact pressures, kt, by the result's law: the standard calibrated
     airspeed (compressible) or sqrt(2 q / rho0) (incompressible)."""
-    if _compressible(result):
-        return mps_to_kt(airdata.cas_from_qc_mps(qc_pa))
-    return mps_to_kt(incompressible_cas_mps(qc_pa))
+    return mps_to_kt(airdata.airspeed_law(result.air_data)[1](qc_pa))
 
 
 def flown_vi_kt(result):

@@ -85,20 +85,17 @@ def kias_targets(plan):
     cal = plan.settings.get("calibration")
     if not cal:
         return None
-    from pitotcal.core import airdata
+    from pitotcal.core.airdata import airspeed_law
+    from pitotcal.core.measurement import isa_air
     from pitotcal.core.models import get_model, qci_from_qc_pa
-    from pitotcal.core.units import incompressible_cas_mps, isa_density_kgm3
 
-    if cal.get("air_data") == "compressible":
-        # the KCAS target by the standard law: its q_c, what the probe then reads, its V_ic
-        qc = airdata.qc_from_cas_pa(plan.cas_mps)
-        qci = qci_from_qc_pa(get_model(cal["model"]), cal["k"], qc)
-        return mps_to_kt(airdata.cas_from_qc_mps(qci))
-    # an incompressible calibration relates q_ci to ½ρV_t² (the paper's eq. 2) and reads
-    # V_ic = sqrt(2 q_ci / ρ0)
-    qc = 0.5 * isa_density_kgm3(plan.alt_m) * plan.tas_mps ** 2
+    # the true q_c of the plan's TAS in the calibration's air data (the standard law for a
+    # compressible one, ½ρV_t² for the paper's eq. 2), what the probe then reads, and the
+    # airspeed an indicator shows for it by the same law
+    mode = cal.get("air_data", "incompressible")
+    qc = isa_air(plan.alt_m, mode).qc_pa(plan.tas_mps ** 2)
     qci = qci_from_qc_pa(get_model(cal["model"]), cal["k"], qc)
-    return mps_to_kt(incompressible_cas_mps(qci))
+    return mps_to_kt(airspeed_law(mode)[1](qci))
 
 
 def calibration_lines(s):
