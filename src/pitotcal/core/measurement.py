@@ -37,7 +37,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import airdata
-from .errors import FlightDataError
+from .errors import FlightDataError, PitotcalError
 from .gps_velocity import estimate_gps_noise_std, interpolate_held
 from .models import qci_from_qc_pa
 from .scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
@@ -223,7 +223,8 @@ def flight_air(flight, air_data=DEFAULT_AIR_DATA):
     `ps_ref_pa` and `oat_k`. A missing channel is a `FlightDataError` naming it.
     """
     if air_data not in AIR_CHANNELS:
-        raise ValueError(f"air_data {air_data!r} is not one of {', '.join(AIR_CHANNELS)}")
+        raise PitotcalError(f"air_data {air_data!r} is not one of {', '.join(AIR_CHANNELS)}",
+                            param="air_data")
     if air_data == "incompressible":
         return IncompressibleAir(np.asarray(flight.rho_kgm3, float))
     names = ("ps_pa", "oat_k") if air_data == "compressible" else ("ps_ref_pa", "oat_k")
