@@ -92,3 +92,18 @@ def test_early_child_without_fork_asks_the_caller(monkeypatch):
                         lambda s: signal.SIG_IGN if s == signal.SIGCHLD else signal.SIG_DFL)
     child = EarlyChild(lambda: None, lambda value: None)
     assert child.send(1) is False and child.join() is False
+
+
+def test_early_child_given_nothing_did_nothing():
+    child = EarlyChild(lambda: None, lambda value: None)
+    assert child.join() is False
+
+
+def test_early_child_abandoned_does_not_wait_for_its_preparation():
+    import time
+
+    t0 = time.perf_counter()
+    with pytest.raises(RuntimeError):
+        with EarlyChild(lambda: time.sleep(30), lambda value: None):
+            raise RuntimeError("bad input")
+    assert time.perf_counter() - t0 < 10

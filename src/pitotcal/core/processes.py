@@ -78,12 +78,13 @@ class EarlyChild:
     `work` must only write files (the child leaves with `os._exit`). `join` says whether the
     child did the work; when it did not (no fork on this platform, a failure in the child, the
     value not picklable), the caller does the work itself, so that an error is raised as usual.
-    Use as a context manager: leaving the block without `join` (an error while computing the
-    input) stops the child, which then does nothing.
+    Use as a context manager: leaving the block before `send` (an error while computing the
+    input) stops the child at once, before it does anything; after `send`, it is waited for.
     """
 
     def __init__(self, prepare, work):
         self._pid = self._write_fd = None
+        self._sent = False
         read_fd, write_fd = os.pipe()
         pid = _fork()
         if pid == 0:                               # the child
@@ -112,13 +113,14 @@ class EarlyChild:
             data = pickle.dumps(value, protocol=pickle.HIGHEST_PROTOCOL)
             with os.fdopen(self._write_fd, "wb") as fh:
                 self._write_fd = None
+                self._sent = True
                 fh.write(data)
         except (OSError, pickle.PicklingError, TypeError, AttributeError):
             return False
         return True
 
     def join(self):
-        """Wait for the child; True if it did the work."""
+        """Wait for the child; True if it did the work (it was sent its input and succeeded)."""
         self._close()
         if self._pid is None:
             return False
@@ -127,7 +129,7 @@ class EarlyChild:
             _, status = os.waitpid(pid, 0)
         except ChildProcessError:
             return False
-        return os.waitstatus_to_exitcode(status) == 0
+        return self._sent and os.waitstatus_to_exitcode(status) == 0
 
     def _close(self):
         if self._write_fd is not None:
@@ -139,6 +141,10 @@ class EarlyChild:
 
     def __exit__(self, *exc):
         self._close()
+        if self._pid is not None and not self._sent:
+            # it has nothing to do: no need to wait for its `prepare` (our own child, by pid)
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(self._pid, signal.SIGKILL)
         if self._pid is not None:
             self.join()
         return False
