@@ -401,11 +401,12 @@ def write_plan_outputs(plan, plan_csv, *, figures=True, early=None):
     figures : bool
         Write the PNGs (matplotlib is the slow part).
     early : pitotcal.core.processes.EarlyChild, optional
-        `start_figures(plan_csv)`, started before planning: it draws the PNGs while the text
-        files are written here. Without it, or if it could not draw them, they are drawn here.
+        `start_figures(plan_csv)`, started before planning: it draws the PNGs (sent the plan
+        here unless the caller already did) while the text files are written here. Without
+        it, or if it could not draw them, they are drawn here.
     """
     paths = output_paths(plan_csv)
-    sent = figures and early is not None and early.send(plan)
+    sent = figures and early is not None and (early.sent or early.send(plan))
     write_plan(plan, paths["plan"])
     write_pilot_card(plan, None, paths["card_txt"])
     write_autothrottle_csv(plan, paths["autothrottle"])

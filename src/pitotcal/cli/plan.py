@@ -108,6 +108,9 @@ def run(args):
 
             mission = build_mission(plan, *args.center, altitude_ref=args.altitude_ref,
                                     ground_elevation_m=args.ground_elevation_m)
+        if early is not None:
+            early.send(plan)                 # the PNGs are drawn from here on
+        check = autothrottle_report(plan)    # meanwhile
         paths = write_plan_outputs(plan, args.output, figures=figures, early=early)
     if mission is not None:
         from pitotcal.maneuvers.plan.missions import mission_path, write_mission
@@ -128,7 +131,7 @@ def run(args):
     for kind, path in paths.items():
         print(f"  {kind:12s} {path}")
     sys.stdout.flush()
-    print(autothrottle_report(plan))
+    print(check)
     if mission is not None:
         print(mission.summary())
     return 0

@@ -105,6 +105,11 @@ class EarlyChild:
             return
         self._pid, self._write_fd = pid, write_fd
 
+    @property
+    def sent(self):
+        """Whether `send` gave the child its input."""
+        return self._sent
+
     def send(self, value):
         """Give the child its input; False if it cannot have it (the caller does the work)."""
         if self._write_fd is None:
