@@ -18,7 +18,7 @@ import numpy as np
 from .card import PNG_OPTIONS, calibration_lines, design_lines, kias_targets, turn_text
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.processes import side_by_side
+from pitotcal.core.processes import EarlyChild, side_by_side
 from pitotcal.core.scenario import ALT_TOLERANCE_FT, CAS_TOLERANCE_KT
 from pitotcal.core.units import m_to_ft, mps_to_kt
 from pitotcal.io.atomic import atomic_open, save_figure
@@ -35,6 +35,7 @@ __all__ = [
     "output_paths",
     "pilot_card_text",
     "plot_plan",
+    "start_figures",
     "write_autothrottle_csv",
     "write_pilot_card",
     "write_plan_outputs",
@@ -345,7 +346,50 @@ def check_output_paths(plan_csv, *, figures=True):
     return paths
 
 
-def write_plan_outputs(plan, plan_csv, *, figures=True):
+def _import_figure():
+    """Load matplotlib's figure module (0.1-0.2 s of CPU beyond `import matplotlib`)."""
+    import matplotlib.figure  # noqa: F401
+
+
+def _prepare_drawing():
+    """`_import_figure` in the forked child that only draws two files and leaves: without the
+    docstrings of the ``set()`` methods matplotlib composes for each of its ~100 artist classes
+    as they are defined (a third of the figure module's import; nobody reads them there).
+    Never done in the caller's process, where help() should show them."""
+    import matplotlib.artist
+
+    matplotlib.artist.kwdoc = lambda artist: ""
+    _import_figure()
+
+
+def _draw_figures(plan, paths):
+    """The card PNG in a forked child while the plan figure is drawn here."""
+    side_by_side(lambda: write_pilot_card(plan, paths["card_png"]),
+                 lambda: plot_plan(plan, paths["figure"]))
+
+
+def start_figures(plan_csv):
+    """Start, before the plan exists, the process that will draw its two PNGs.
+
+    A forked child (`pitotcal.core.processes.EarlyChild`) imports matplotlib's figure module
+    while this process plans, and draws the card and plan figure of the plan that
+    `write_plan_outputs(plan, plan_csv, early=...)` sends it. Use it as a context manager
+    around the planning: an error before the plan is written stops the child.
+
+    Parameters
+    ----------
+    plan_csv : path-like
+        The plan CSV the PNGs go beside (`output_paths`); the same as `write_plan_outputs`'.
+
+    Returns
+    -------
+    pitotcal.core.processes.EarlyChild
+    """
+    paths = output_paths(plan_csv)
+    return EarlyChild(_prepare_drawing, lambda plan: _draw_figures(plan, paths))
+
+
+def write_plan_outputs(plan, plan_csv, *, figures=True, early=None):
     """Write the plan CSV and its companions beside it; returns {kind: path}.
 
     Parameters
@@ -356,20 +400,22 @@ def write_plan_outputs(plan, plan_csv, *, figures=True):
         ``.autothrottle.csv`` and ``.png``.
     figures : bool
         Write the PNGs (matplotlib is the slow part).
+    early : pitotcal.core.processes.EarlyChild, optional
+        `start_figures(plan_csv)`, started before planning: it draws the PNGs (sent the plan
+        here unless the caller already did) while the text files are written here. Without
+        it, or if it could not draw them, they are drawn here.
     """
     paths = output_paths(plan_csv)
+    sent = figures and early is not None and (early.sent or early.send(plan))
     write_plan(plan, paths["plan"])
     write_pilot_card(plan, None, paths["card_txt"])
     write_autothrottle_csv(plan, paths["autothrottle"])
-    if figures:
-        # the two PNGs are most of a default `pitotcal plan` (0.2 s each): draw them at once;
-        # matplotlib's figure module (~0.35 s to import) is loaded before the fork so that the
-        # child inherits it instead of importing it again (on a busy machine the two imports
-        # compete for the same core)
-        import matplotlib.figure  # noqa: F401
-
-        side_by_side(lambda: write_pilot_card(plan, paths["card_png"]),
-                     lambda: plot_plan(plan, paths["figure"]))
-    else:
+    if not figures:
         del paths["card_png"], paths["figure"]
+    elif not (sent and early.join()):
+        # the two PNGs are most of a default `pitotcal plan` (0.15-0.2 s each): drawn at once;
+        # matplotlib's figure module is loaded before the fork so that the child inherits it
+        # instead of importing it again (on a busy machine the two imports compete for a core)
+        _import_figure()
+        _draw_figures(plan, paths)
     return paths

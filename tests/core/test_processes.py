@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from pitotcal.core.processes import side_by_side, solver_interrupts
+from pitotcal.core.processes import EarlyChild, side_by_side, solver_interrupts
 
 
 def test_both_run_and_the_childs_file_is_there(tmp_path):
@@ -58,3 +58,52 @@ def test_outside_the_main_thread_nothing_changes():
     t.start()
     t.join()
     assert seen == [True]
+
+
+def test_early_child_prepares_then_works_on_what_it_is_sent(tmp_path):
+    out = tmp_path / "out.txt"
+    with EarlyChild(lambda: None, lambda value: out.write_text(f"{value} {os.getpid()}")) as c:
+        assert c.send({"k": 3})
+        assert c.join()
+    value, pid = out.read_text().rsplit(" ", 1)
+    assert value == "{'k': 3}" and int(pid) != os.getpid()
+
+
+@pytest.mark.parametrize("where", ["prepare", "work"])
+def test_early_child_that_fails_says_so(tmp_path, where):
+    def fail(*_):
+        raise ValueError("cannot draw")
+    prepare, work = (fail, lambda v: None) if where == "prepare" else (lambda: None, fail)
+    child = EarlyChild(prepare, work)
+    child.send(list(range(100_000)))           # more than a pipe holds: no hang either way
+    assert child.join() is False
+
+
+def test_early_child_left_without_input_does_nothing(tmp_path):
+    out = tmp_path / "out.txt"
+    with pytest.raises(RuntimeError, match="no plan"):
+        with EarlyChild(lambda: None, lambda value: out.write_text("drawn")):
+            raise RuntimeError("no plan")
+    assert not out.exists()
+
+
+def test_early_child_without_fork_asks_the_caller(monkeypatch):
+    monkeypatch.setattr(signal, "getsignal",
+                        lambda s: signal.SIG_IGN if s == signal.SIGCHLD else signal.SIG_DFL)
+    child = EarlyChild(lambda: None, lambda value: None)
+    assert child.send(1) is False and child.join() is False
+
+
+def test_early_child_given_nothing_did_nothing():
+    child = EarlyChild(lambda: None, lambda value: None)
+    assert child.join() is False
+
+
+def test_early_child_abandoned_does_not_wait_for_its_preparation():
+    import time
+
+    t0 = time.perf_counter()
+    with pytest.raises(RuntimeError):
+        with EarlyChild(lambda: time.sleep(30), lambda value: None):
+            raise RuntimeError("bad input")
+    assert time.perf_counter() - t0 < 10

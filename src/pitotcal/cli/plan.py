@@ -1,6 +1,7 @@
 """`pitotcal plan`: plan a calibration maneuver and write its CSV, pilot card and setpoints
 (docs/interfaces.md). Defaults are the T-2 case of the reference paper."""
 
+import contextlib
 import dataclasses
 import sys
 
@@ -82,28 +83,35 @@ def _help_constants():
 
 
 def run(args):
-    from pitotcal.maneuvers.plan.autothrottle import autothrottle_report
-    from pitotcal.maneuvers.plan.outputs import check_output_paths, write_plan_outputs
-    from pitotcal.maneuvers.plan.planner import MAX_ITER, check_converged, plan_maneuver
+    from pitotcal.maneuvers.plan.outputs import (check_output_paths, start_figures,
+                                                 write_plan_outputs)
 
     figures = not args.no_figures
-    max_iter = MAX_ITER if args.max_iter is None else args.max_iter
     paths = check_output_paths(args.output, figures=figures)
     geo = _geo_settings(args)
     _check_outputs(args, paths)
     calibration = _calibration(args.calibration)
-    plan = plan_maneuver(_request(args, max_iter))
-    check_converged(plan, max_iter)
-    if geo or calibration:
-        plan = dataclasses.replace(plan, settings={**plan.settings, **geo, **calibration})
-    mission = None
-    if args.export:
-        # refused (the loiter's bank or heading coverage) before any file is written
-        from pitotcal.maneuvers.plan.missions import build_mission
+    # the PNGs' process imports matplotlib while CasADi is imported and the plan solved here
+    with start_figures(args.output) if figures else contextlib.nullcontext() as early:
+        from pitotcal.maneuvers.plan.autothrottle import autothrottle_report
+        from pitotcal.maneuvers.plan.planner import MAX_ITER, check_converged, plan_maneuver
 
-        mission = build_mission(plan, *args.center, altitude_ref=args.altitude_ref,
-                                ground_elevation_m=args.ground_elevation_m)
-    paths = write_plan_outputs(plan, args.output, figures=figures)
+        max_iter = MAX_ITER if args.max_iter is None else args.max_iter
+        plan = plan_maneuver(_request(args, max_iter))
+        check_converged(plan, max_iter)
+        if geo or calibration:
+            plan = dataclasses.replace(plan, settings={**plan.settings, **geo, **calibration})
+        mission = None
+        if args.export:
+            # refused (the loiter's bank or heading coverage) before any file is written
+            from pitotcal.maneuvers.plan.missions import build_mission
+
+            mission = build_mission(plan, *args.center, altitude_ref=args.altitude_ref,
+                                    ground_elevation_m=args.ground_elevation_m)
+        if early is not None:
+            early.send(plan)                 # the PNGs are drawn from here on
+        check = autothrottle_report(plan)    # meanwhile
+        paths = write_plan_outputs(plan, args.output, figures=figures, early=early)
     if mission is not None:
         from pitotcal.maneuvers.plan.missions import mission_path, write_mission
 
@@ -123,7 +131,7 @@ def run(args):
     for kind, path in paths.items():
         print(f"  {kind:12s} {path}")
     sys.stdout.flush()
-    print(autothrottle_report(plan))
+    print(check)
     if mission is not None:
         print(mission.summary())
     return 0

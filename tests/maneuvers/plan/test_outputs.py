@@ -9,6 +9,7 @@ from pitotcal.maneuvers.plan.outputs import (
     check_output_paths,
     output_paths,
     pilot_card_text,
+    start_figures,
     write_plan_outputs,
 )
 from pitotcal.maneuvers.plan.planner import plan_maneuver
@@ -74,6 +75,17 @@ def test_figures_are_pngs(tmp_path):
     for key in ("card_png", "figure"):
         data = paths[key].read_bytes()
         assert data.startswith(PNG_MAGIC) and len(data) > 20_000
+
+
+def test_figures_started_before_the_plan_are_the_same(tmp_path):
+    """`start_figures` (the child that imports matplotlib while the plan is solved) writes the
+    same PNGs, byte for byte, as drawing them after the plan."""
+    with start_figures(tmp_path / "early.csv") as early:
+        plan = plan_maneuver("two-speed")
+        early_paths = write_plan_outputs(plan, tmp_path / "early.csv", early=early)
+    here = write_plan_outputs(plan, tmp_path / "here.csv")
+    for key in ("card_png", "figure"):
+        assert early_paths[key].read_bytes() == here[key].read_bytes()
 
 
 def test_output_paths_beside_the_plan(tmp_path):
