@@ -73,43 +73,19 @@ def draw_text_block(fig, text, x, y, fontsize):
     lines spaced the same way, each line rendered by FreeType in one call instead of glyph by
     glyph (matplotlib's Agg renderer places every glyph from Python: 0.1 s of CPU for the
     card's ~1,400 characters, against 0.01 s here). Glyphs sit on whole pixels. `fig` must
-    have the dpi it is saved at (the image is not resampled). A character the font lacks, a
-    font without line metrics, or a matplotlib without these FreeType calls, is left to
-    ``fig.text``, which can fall back to other fonts.
+    have the dpi it is saved at (the image is not resampled). A character the font lacks, or
+    a font without line metrics, is left to ``fig.text``, which can fall back to other fonts.
     """
     from matplotlib import colors, rcParams
+    from matplotlib.backends.backend_agg import get_hinting_flag
     from matplotlib.font_manager import FontProperties, findfont, get_font
 
     font = get_font(findfont(FontProperties(family="monospace")))
     metrics = _font_metrics(font, fontsize, fig.dpi)
-    drawn = None
-    if metrics is not None and set(map(ord, text)) - {10} <= font.get_charmap().keys():
-        try:
-            drawn = _text_coverage(font, text, fontsize, fig.dpi, metrics)
-        except AttributeError:
-            drawn = None
-    if drawn is None:
+    if metrics is None or not set(map(ord, text)) - {10} <= font.get_charmap().keys():
         fig.text(x, y, text, family="monospace", fontsize=fontsize, va="top")
         return
-    alpha, top, left = drawn
-    if alpha.size == 0:
-        return
-    rgba = np.empty(alpha.shape + (4,), np.uint8)     # the text colour, the coverage as alpha
-    rgba[..., :3] = np.round(255 * np.array(colors.to_rgb(rcParams["text.color"])))
-    rgba[..., 3] = alpha
-    top_px = (1.0 - y) * fig.bbox.height + top
-    fig.figimage(rgba, xo=round(x * fig.bbox.width) + left,
-                 yo=round(fig.bbox.height - top_px - alpha.shape[0]), origin="upper")
-
-
-def _text_coverage(font, text, fontsize, dpi, metrics):
-    """(coverage, top, left): `text`'s lines rendered by `font`, uint8 (rows, cols), its top
-    row and left column in pixels from the block's top left; lines spaced as matplotlib's
-    ``Text`` spaces them (each line's ascent and descent at least the font's, plus half the
-    line gap on either side)."""
-    from matplotlib.backends.backend_agg import get_hinting_flag
-
-    font.set_size(fontsize, dpi)
+    font.set_size(fontsize, fig.dpi)
     lines = text.split("\n")
     min_ascent, min_descent, gap = metrics if len(lines) > 1 else (*metrics[:2], 0.0)
     flags = get_hinting_flag()
@@ -128,7 +104,7 @@ def _text_coverage(font, text, fontsize, dpi, metrics):
             pieces.append((image, top, round(font.get_bitmap_offset()[0] / 64.0)))
         baseline += max(descent, min_descent) + gap / 2
     if not pieces:
-        return np.zeros((0, 0), np.uint8), 0, 0
+        return
     first = min(top for _, top, _ in pieces)
     leftmost = min(left for _, _, left in pieces)
     rows = max(top + image.shape[0] for image, top, _ in pieces) - first
@@ -138,7 +114,13 @@ def _text_coverage(font, text, fontsize, dpi, metrics):
         r, c = top - first, left - leftmost
         window = alpha[r:r + image.shape[0], c:c + image.shape[1]]
         np.maximum(window, image, out=window)
-    return alpha, first, leftmost
+    rgba = np.empty((rows, cols, 4), np.uint8)        # the text colour, the coverage as alpha
+    rgba[..., :3] = np.round(255 * np.array(colors.to_rgb(rcParams["text.color"])))
+    rgba[..., 3] = alpha
+    top_px = (1.0 - y) * fig.bbox.height + first
+    fig.figimage(rgba, xo=round(x * fig.bbox.width) + leftmost,
+                 yo=round(fig.bbox.height - top_px - rows),
+                 origin="upper")
 
 
 def draw_track_sketch(ax, plan):

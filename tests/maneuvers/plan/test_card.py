@@ -98,17 +98,3 @@ def test_text_block_leaves_a_character_the_font_lacks_to_matplotlib():
     draw_text_block(fig, "calibration from \U0001F600.json", 0.05, 0.9, fontsize=8)
     assert [t.get_text() for t in fig.texts] == ["calibration from \U0001F600.json"]
     assert not fig.images
-
-
-def test_text_block_without_the_freetype_calls_is_left_to_matplotlib(monkeypatch):
-    """A matplotlib whose FT2Font lacks a call the block uses: fig.text draws it."""
-    from matplotlib.figure import Figure
-    from pitotcal.maneuvers.plan import card
-
-    def missing(*args):
-        raise AttributeError("'FT2Font' object has no attribute 'draw_glyphs_to_bitmap'")
-
-    monkeypatch.setattr(card, "_text_coverage", missing)
-    fig = Figure(dpi=110)
-    draw_text_block(fig, "TIME  KCAS\n0:00  70.0±5\n", 0.05, 0.9, fontsize=8)
-    assert [t.get_text() for t in fig.texts] == ["TIME  KCAS\n0:00  70.0±5\n"]
