@@ -13,7 +13,7 @@ from pitotcal.core.units import m_to_ft, mps_to_kt
 from pitotcal.io.atomic import save_figure
 
 __all__ = ["PNG_OPTIONS", "calibration_lines", "design_lines", "draw_card",
-           "draw_text_block", "draw_track_sketch", "kias_targets", "turn_text"]
+           "draw_track_sketch", "kias_targets", "turn_text"]
 
 # The plan's PNGs (card and plan figure): zlib level 1 encodes them in about a third of the
 # default level's time (0.18 against 0.27 s for the plan figure) for files 7 % larger
@@ -29,8 +29,7 @@ def draw_card(plan, text, png_path):
 
     rows = text.splitlines()
     height = 2.9 + 0.135 * len(rows)
-    # at the PNG's dpi: the text block is an image of that many pixels (`draw_text_block`)
-    fig = Figure(figsize=(8.27, height), dpi=PNG_OPTIONS["dpi"])
+    fig = Figure(figsize=(8.27, height))
     # top: the speed trace with its tolerance band, what the pilot is judged against
     ax = fig.add_axes([0.09, 1 - 2.1 / height, 0.55 if sketch else 0.8, 1.8 / height])
     kt = mps_to_kt(plan.cas_mps)
@@ -48,79 +47,8 @@ def draw_card(plan, text, png_path):
         # square in inches: 1.8 in tall, 1.8 in wide
         draw_track_sketch(fig.add_axes([0.76, 1 - 2.1 / height, 1.8 / 8.27, 1.8 / height]),
                           plan)
-    draw_text_block(fig, text, 0.04, 1 - 2.65 / height, fontsize=8)
+    fig.text(0.04, 1 - 2.65 / height, text, family="monospace", fontsize=8, va="top")
     save_figure(fig, png_path, **PNG_OPTIONS)
-
-
-def _font_metrics(font, fontsize, dpi):
-    """(ascent, descent, line gap) in pixels from the font's tables, as matplotlib spaces the
-    lines of a text (None without the tables)."""
-    head = font.get_sfnt_table("head")
-    for table, keys in (("OS/2", ("sTypoAscender", "sTypoDescender", "sTypoLineGap")),
-                        ("hhea", ("ascent", "descent", "lineGap"))):
-        values = font.get_sfnt_table(table)
-        if values is not None and head is not None:
-            scale = fontsize * dpi / 72.0 / head["unitsPerEm"]
-            return (values[keys[0]] * scale, -values[keys[1]] * scale,
-                    values[keys[2]] * scale)
-    return None
-
-
-def draw_text_block(fig, text, x, y, fontsize):
-    """Monospace `text` with its top left at figure fraction (`x`, `y`), as one image.
-
-    What ``fig.text(x, y, text, family="monospace", fontsize=fontsize, va="top")`` draws,
-    lines spaced the same way, each line rendered by FreeType in one call instead of glyph by
-    glyph (matplotlib's Agg renderer places every glyph from Python: 0.1 s of CPU for the
-    card's ~1,400 characters, against 0.01 s here). Glyphs sit on whole pixels. `fig` must
-    have the dpi it is saved at (the image is not resampled). A character the font lacks, or
-    a font without line metrics, is left to ``fig.text``, which can fall back to other fonts.
-    """
-    from matplotlib import colors, rcParams
-    from matplotlib.backends.backend_agg import get_hinting_flag
-    from matplotlib.font_manager import FontProperties, findfont, get_font
-
-    font = get_font(findfont(FontProperties(family="monospace")))
-    metrics = _font_metrics(font, fontsize, fig.dpi)
-    if metrics is None or not set(map(ord, text)) - {10} <= font.get_charmap().keys():
-        fig.text(x, y, text, family="monospace", fontsize=fontsize, va="top")
-        return
-    font.set_size(fontsize, fig.dpi)
-    lines = text.split("\n")
-    min_ascent, min_descent, gap = metrics if len(lines) > 1 else (*metrics[:2], 0.0)
-    flags = get_hinting_flag()
-    pieces, baseline = [], 0.0            # baseline: pixels below the block's top
-    for line in lines:
-        height = descent = 0.0
-        if line:
-            font.set_text(line, 0.0, flags=flags)
-            height, descent = font.get_width_height()[1] / 64.0, font.get_descent() / 64.0
-        baseline += max(height - descent, min_ascent) + gap / 2
-        if line.strip():
-            font.draw_glyphs_to_bitmap(antialiased=True)
-            image = np.asarray(font.get_image())
-            # the bitmap's bottom row is the descent below the baseline
-            top = round(baseline + descent) - image.shape[0]
-            pieces.append((image, top, round(font.get_bitmap_offset()[0] / 64.0)))
-        baseline += max(descent, min_descent) + gap / 2
-    if not pieces:
-        return
-    first = min(top for _, top, _ in pieces)
-    leftmost = min(left for _, _, left in pieces)
-    rows = max(top + image.shape[0] for image, top, _ in pieces) - first
-    cols = max(left + image.shape[1] for image, _, left in pieces) - leftmost
-    alpha = np.zeros((rows, cols), np.uint8)
-    for image, top, left in pieces:
-        r, c = top - first, left - leftmost
-        window = alpha[r:r + image.shape[0], c:c + image.shape[1]]
-        np.maximum(window, image, out=window)
-    rgba = np.empty((rows, cols, 4), np.uint8)        # the text colour, the coverage as alpha
-    rgba[..., :3] = np.round(255 * np.array(colors.to_rgb(rcParams["text.color"])))
-    rgba[..., 3] = alpha
-    top_px = (1.0 - y) * fig.bbox.height + first
-    fig.figimage(rgba, xo=round(x * fig.bbox.width) + leftmost,
-                 yo=round(fig.bbox.height - top_px - rows),
-                 origin="upper")
 
 
 def draw_track_sketch(ax, plan):

@@ -2,7 +2,7 @@
 the calibration."""
 
 import numpy as np
-from pitotcal.maneuvers.plan.card import draw_text_block, draw_track_sketch, kias_targets
+from pitotcal.maneuvers.plan.card import draw_track_sketch, kias_targets
 
 from pitotcal.core.models import delta_v_kt, get_model
 from pitotcal.core.plan import Plan
@@ -55,46 +55,3 @@ def test_kias_targets_of_a_compressible_calibration_use_the_standard_law():
     np.testing.assert_allclose(back, mps_to_kt(plan.cas_mps), atol=1e-6)
     incompressible = kias_targets(_plan({"calibration": {**cal, "air_data": "incompressible"}}))
     assert np.max(np.abs(kias - incompressible)) > 1e-4
-
-
-def _pixels(draw):
-    """The darkness (0-255) of a 6 x 3 in figure at 110 dpi with `draw(fig)` on it."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(6, 3), dpi=110)
-    draw(fig)
-    canvas = FigureCanvasAgg(fig)
-    canvas.draw()
-    return 255.0 - np.asarray(canvas.buffer_rgba())[..., :3].mean(axis=2)
-
-
-def _line_rows(dark):
-    """(first, last) row of each run of inked rows."""
-    inked = np.r_[0, (dark.sum(axis=1) > 0).astype(int), 0]
-    edges = np.flatnonzero(np.diff(inked))
-    return np.column_stack([edges[::2], edges[1::2]])
-
-
-def test_text_block_draws_what_fig_text_draws():
-    """The card's text as one image: the same glyphs (ink within 0.5 %) on the same lines
-    (within 2 pixels) as matplotlib's own monospace text, blank line included."""
-    text = "TIME  KCAS   BANK\n0:00  70.0±5  R19°  015°\n\n4:00 100.0±5  end |_gy\n"
-    mine = _pixels(lambda fig: draw_text_block(fig, text, 0.05, 0.9, fontsize=8))
-    ref = _pixels(lambda fig: fig.text(0.05, 0.9, text, family="monospace", fontsize=8,
-                                       va="top"))
-    assert abs(mine.sum() / ref.sum() - 1) < 0.005
-    rows_mine, rows_ref = _line_rows(mine), _line_rows(ref)
-    assert rows_mine.shape == rows_ref.shape == (3, 2)
-    assert np.abs(rows_mine - rows_ref).max() <= 2
-    cols = np.flatnonzero(mine.sum(axis=0) > 0), np.flatnonzero(ref.sum(axis=0) > 0)
-    assert abs(cols[0][0] - cols[1][0]) <= 1 and abs(cols[0][-1] - cols[1][-1]) <= 1
-
-
-def test_text_block_leaves_a_character_the_font_lacks_to_matplotlib():
-    from matplotlib.figure import Figure
-
-    fig = Figure(dpi=110)
-    draw_text_block(fig, "calibration from \U0001F600.json", 0.05, 0.9, fontsize=8)
-    assert [t.get_text() for t in fig.texts] == ["calibration from \U0001F600.json"]
-    assert not fig.images
