@@ -351,17 +351,6 @@ def _import_figure():
     import matplotlib.figure  # noqa: F401
 
 
-def _prepare_drawing():
-    """`_import_figure` in the forked child that only draws two files and leaves: without the
-    docstrings of the ``set()`` methods matplotlib composes for each of its ~100 artist classes
-    as they are defined (a third of the figure module's import; nobody reads them there).
-    Never done in the caller's process, where help() should show them."""
-    import matplotlib.artist
-
-    matplotlib.artist.kwdoc = lambda artist: ""
-    _import_figure()
-
-
 def _draw_figures(plan, paths):
     """The card PNG in a forked child while the plan figure is drawn here."""
     side_by_side(lambda: write_pilot_card(plan, paths["card_png"]),
@@ -386,7 +375,7 @@ def start_figures(plan_csv):
     pitotcal.core.processes.EarlyChild
     """
     paths = output_paths(plan_csv)
-    return EarlyChild(_prepare_drawing, lambda plan: _draw_figures(plan, paths))
+    return EarlyChild(_import_figure, lambda plan: _draw_figures(plan, paths))
 
 
 def write_plan_outputs(plan, plan_csv, *, figures=True, early=None):
