@@ -10,6 +10,9 @@ the same loop (the commands alternate, each in a fresh process): the bare
 figure machinery the PNGs need). Each command's wall time and its CPU time (user + system of
 the process and the children it waits for: the forked figure process) are reported with their
 ratios to the baselines; on a loaded machine the CPU ratio is the steadier one.
+``--before DIR`` adds, to the same loop, the command run from another copy of the package
+(``PYTHONPATH=DIR``, a folder holding a `pitotcal` package, e.g. an older commit laid out as
+installed): a before/after comparison under the same load. The load average is printed.
 """
 
 import argparse
@@ -29,28 +32,32 @@ BASELINES = {
 }
 
 
-def _run(cmd):
+def _run(cmd, env=None):
     """(wall s, CPU s) of one fresh process, children included."""
     before = os.times()
     t0 = time.perf_counter()
-    subprocess.run(cmd, check=True, capture_output=True)
+    subprocess.run(cmd, check=True, capture_output=True, env=env)
     wall = time.perf_counter() - t0
     after = os.times()
     return wall, (after.children_user - before.children_user
                   + after.children_system - before.children_system)
 
 
-def command_ratios(repeats, extra=()):
+def command_ratios(repeats, extra=(), before=None):
     """Medians (wall, CPU) of the default `pitotcal plan` (plus `extra` flags) and of the
-    baselines, run alternately in fresh processes: {name: (wall_s, cpu_s)}."""
+    baselines, run alternately in fresh processes: {name: (wall_s, cpu_s)}; with `before` (a
+    PYTHONPATH folder) also the command from that copy of the package, as "before"."""
     with tempfile.TemporaryDirectory() as tmp:
         plan = [sys.executable, "-m", "pitotcal", "plan", "-o", str(Path(tmp) / "p.csv"),
                 *extra]
-        cmds = {**BASELINES, "plan": plan}
+        cmds = {name: (cmd, None) for name, cmd in BASELINES.items()}
+        cmds["plan"] = (plan, None)
+        if before is not None:
+            cmds["before"] = (plan, {**os.environ, "PYTHONPATH": str(before)})
         runs = {name: [] for name in cmds}
         for _ in range(repeats):
-            for name, cmd in cmds.items():
-                runs[name].append(_run(cmd))
+            for name, (cmd, env) in cmds.items():
+                runs[name].append(_run(cmd, env))
     return {name: (statistics.median(w for w, _ in r), statistics.median(c for _, c in r))
             for name, r in runs.items()}
 
@@ -61,8 +68,8 @@ def command_ratio(repeats, extra=()):
     return med["plan"][0], med["pyplot"][0], med["plan"][0] / med["pyplot"][0]
 
 
-def _ratio_note(med):
-    wall, cpu = med["plan"]
+def _ratio_note(med, name="plan"):
+    wall, cpu = med[name]
     return ", ".join(f"{wall / med[b][0]:.2f}x wall / {cpu / med[b][1]:.2f}x CPU of {b}"
                      for b in BASELINES)
 
@@ -70,7 +77,12 @@ def _ratio_note(med):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=7)
+    parser.add_argument("--before", type=Path, default=None, metavar="DIR",
+                        help="also time `pitotcal plan` from this PYTHONPATH folder")
+    parser.add_argument("--command-only", action="store_true",
+                        help="time only the commands, not the planner's steps")
     args = parser.parse_args(argv)
+    load = os.getloadavg()
     r = args.repeats
 
     import casadi  # noqa: F401  (import time is not planning time)
@@ -80,6 +92,8 @@ def main(argv=None):
     from pitotcal.core.errors import PlanInfeasibleError
 
     rows = []
+    if args.command_only:
+        return _commands(rows, r, args.before, load)
     rows.append(("OCP build, N = 240", median_s(lambda: ManeuverProblem(240, 3), r), ""))
 
     def cold():
@@ -112,27 +126,38 @@ def main(argv=None):
     rows.append(("refuse radius 484 m (main solve + radius-minimising solve)", t_refuse,
                  msg.rsplit(":", 1)[-1].strip()))
 
-    med = command_ratios(r)
+    verdict = "PASS" if t_cold <= 5.0 else "FAIL"
+    _commands(rows, r, args.before, load)
+    print(f"default 240 s continuous plan, cold: {t_cold:.3f} s (target <= 5 s, aim 1 s): "
+          f"{verdict}")
+
+
+def _commands(rows, r, before, load):
+    """Time the commands beside the baselines and print `rows` and the ratios."""
+    med = command_ratios(r, before=before)
     nofig = command_ratios(r, ["--no-figures"])
     for name, cmd in BASELINES.items():
         rows.append((f"`{' '.join(cmd[1:])}` (baseline)", med[name][0],
                      f"CPU {med[name][1]:.3f} s"))
     rows.append(("`pitotcal plan` (process, imports, plan, 5 files, check)", med["plan"][0],
                  f"CPU {med['plan'][1]:.3f} s; {_ratio_note(med)}"))
+    if before is not None:
+        rows.append(("`pitotcal plan` from --before", med["before"][0],
+                     f"CPU {med['before'][1]:.3f} s; {_ratio_note(med, 'before')}"))
     rows.append(("`pitotcal plan --no-figures`", nofig["plan"][0],
                  f"CPU {nofig['plan'][1]:.3f} s; {_ratio_note(nofig)}"))
 
     print(f"| step (median of {r}) | wall s | note |\n|---|---:|---|")
     for name, t, note in rows:
         print(f"| {name} | {t:.3f} | {note} |")
-    verdict = "PASS" if t_cold <= 5.0 else "FAIL"
-    print(f"\ndefault 240 s continuous plan, cold: {t_cold:.3f} s (target <= 5 s, aim 1 s): "
-          f"{verdict}")
+    print()
     for b in BASELINES:
         ratio = med["plan"][0] / med[b][0]
         print(f"default `pitotcal plan`: {ratio:.2f}x the {b} import's wall time, "
               f"{med['plan'][1] / med[b][1]:.2f}x its CPU (target <= 2): "
               f"{'PASS' if ratio <= 2.0 else 'FAIL'}")
+    print("load average (1, 5, 15 min) before: {:.2f} {:.2f} {:.2f}, after: {:.2f} {:.2f} "
+          "{:.2f}".format(*load, *os.getloadavg()))
 
 
 if __name__ == "__main__":
