@@ -10,6 +10,7 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA
 
 from ..uncertainty.block_noise import block_residual_stats
+from . import static_source
 from .budget import BudgetInputs, uncertainty_budget
 from .fit import (
     MAX_CORRELATION,
@@ -20,6 +21,7 @@ from .fit import (
     fit,
     track_spread_deg,
 )
+from .view import correction_table
 
 __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG",
            "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
@@ -143,6 +145,26 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
         gps_error={"stated": sigma is not None, "sigma_mps": sigma, "tau_s": tau},
         reading=None if reading is None else dict(reading), source=str(flight.source),
         n_dropped=int(flight.n_dropped))
+    result = _with_warning(result, _static_note(result))
     if budget is None:
         return result
-    return dataclasses.replace(result, budget=uncertainty_budget(flight, result, budget, air=air))
+    try:
+        return dataclasses.replace(
+            result, budget=uncertainty_budget(flight, result, budget, air=air))
+    except PitotcalError as exc:        # the calibration stands without its budget
+        return _with_warning(result, f"{result.source}: the uncertainty budget was not "
+                                     f"computed: {exc}")
+
+
+def _static_note(result):
+    """The warning naming the static-source products the record cannot hold, or None."""
+    if result.air_data != "compressible" or result.ps_pa is None:
+        return None
+    return static_source.unavailable_warning(result, correction_table(result))
+
+
+def _with_warning(result, note):
+    """`result` with `note` added to its warnings (None: unchanged)."""
+    if not note or note in result.warnings:
+        return result
+    return dataclasses.replace(result, warnings=tuple(result.warnings) + (note,))
