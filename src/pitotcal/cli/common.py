@@ -53,8 +53,10 @@ def announce_stream(command, connection, idle_s):
     """One stderr line as a live MAVLink stream starts: where it listens, how long it waits."""
     import sys
 
-    from pitotcal.io.mavlink_live import FIRST_MESSAGE_TIMEOUT_S, LISTENING_PREFIXES
+    from pitotcal.io.mavlink_live import (
+        FIRST_MESSAGE_TIMEOUT_S, LISTENING_PREFIXES, check_connection)
 
+    check_connection(connection)
     how = "listening on" if str(connection).startswith(LISTENING_PREFIXES) else "connecting to"
     print(f"pitotcal {command}: {how} {connection} for MAVLink (up to "
           f"{FIRST_MESSAGE_TIMEOUT_S:g} s for the first message, then ends after {idle_s:g} s "
