@@ -100,3 +100,51 @@ def test_plan_target_2sigma_nan(tmp_path, capsys):
 def test_monitor_accepts_the_clean_calibration(flown, capsys):
     main(["monitor", str(flown[0]), "--calibration", str(flown[1])])
     assert "alarm" in capsys.readouterr().out
+
+
+def test_legs_all_zero_groundspeed_sd_kt(tmp_path, capsys):
+    legs = tmp_path / "legs.csv"
+    legs.write_text("point,ias_kt,pressure_alt_ft,oat_c,groundspeed_kt,track_deg,"
+                    "groundspeed_sd_kt\n1,100,3000,10,100,0,0\n1,100,3000,10,110,120,0\n"
+                    "1,100,3000,10,90,240,0\n")
+    _refused(["legs", legs], capsys, "column groundspeed_sd_kt", "row 1", "0 is no accuracy")
+
+
+def test_legs_smooth_s_1e9_is_capped_by_the_record(flown, capsys):
+    import resource
+
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    _refused(["legs", flown[0], "--smooth-s", "1e9"], capsys, "no steady segment")
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 500_000   # kB
+
+
+@pytest.mark.parametrize("argv", [
+    ["identify", "{flight}", "--json", "-"],
+    ["monitor", "{flight}", "--calibration", "{result}", "--json", "-"],
+    ["report", "{result}", "-o", "-"],
+])
+def test_dash_as_an_output_is_refused_not_a_file_named_dash(argv, flown, tmp_path, capsys,
+                                                          monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    argv = [a.format(flight=flown[0], result=flown[1]) for a in argv]
+    _refused(argv, capsys, " -: an output here is a file, not stdout")
+    assert not (tmp_path / "-").exists()
+
+
+def test_oat_cells_in_celsius_are_named_not_a_mach_error(flown, tmp_path, capsys):
+    """2 % of oat_k cells in degC gave "mach 1.00463 is outside the subsonic range" naming
+    nothing; 0.5 % are dropped as glitches with a warning."""
+    lines = flown[0].read_text().splitlines()
+    head = next(i for i, line in enumerate(lines) if line.startswith("time_s"))
+    j = lines[head].split(",").index("oat_k")
+    for every, refused in ((50, True), (200, False)):
+        rows = [line.split(",") for line in lines[head + 1:]]
+        for row in rows[::every]:
+            row[j] = f"{float(row[j]) - 273.15:.3f}"
+        path = tmp_path / f"oat_c_every_{every}.csv"
+        path.write_text("\n".join(lines[:head + 1] + [",".join(r) for r in rows]) + "\n")
+        if refused:
+            _refused(["identify", path], capsys, "column oat_k", "outside the plausible 150")
+        else:
+            assert main(["identify", str(path), "--no-budget"]) in (0, None)
+            assert "dropped" in capsys.readouterr().err

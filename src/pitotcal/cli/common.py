@@ -115,6 +115,9 @@ def _as_written(path, figure):
 def _check_one(flag, out, inputs):
     from pitotcal.core.errors import PitotcalError
 
+    if str(out) == "-":                 # stdout carries the summary: no JSON mixed into it
+        raise PitotcalError(f"{flag} -: an output here is a file, not stdout (which carries "
+                            "the summary): give a file name")
     if out.is_dir():
         raise PitotcalError(f"{flag} {out} is a folder: give the file to write")
     for source, what in inputs:
