@@ -8,6 +8,7 @@ import dataclasses
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA
+from pitotcal.io.result_record import check_noise_model
 
 from ..uncertainty.block_noise import block_residual_stats
 from . import static_source
@@ -134,10 +135,7 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
     gps_error : (sigma_mps, tau_s)
         The stated GPS velocity error (None, None: none stated).
     """
-    try:
-        noise = block_residual_stats(result)
-    except PitotcalError:               # too short a record for the monitor's blocks
-        noise = None
+    noise, noise_note = _monitor_noise(result)
     reading = getattr(flight, "reading", None)
     sigma, tau = gps_error
     result = dataclasses.replace(
@@ -145,7 +143,7 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
         gps_error={"stated": sigma is not None, "sigma_mps": sigma, "tau_s": tau},
         reading=None if reading is None else dict(reading), source=str(flight.source),
         n_dropped=int(flight.n_dropped))
-    result = _with_warning(result, _static_note(result))
+    result = _with_warning(_with_warning(result, noise_note), _static_note(result))
     if budget is None:
         return result
     try:
@@ -154,6 +152,22 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
     except PitotcalError as exc:        # the calibration stands without its budget
         return _with_warning(result, f"{result.source}: the uncertainty budget was not "
                                      f"computed: {exc}")
+
+
+def _monitor_noise(result):
+    """(the residuals' noise model for `pitotcal monitor`, or None; a warning or None): None
+    without a warning for a record too short for the monitor's blocks, with one when the
+    model is degenerate (a zero or non-finite scale the monitor could not test against)."""
+    try:
+        noise = block_residual_stats(result)
+    except PitotcalError:               # too short a record for the monitor's blocks
+        return None, None
+    try:
+        check_noise_model("noise_model", noise)
+    except PitotcalError as exc:
+        return None, (f"{result.source}: the monitor's noise model was not computed ({exc}); "
+                      "the record carries noise_std_pa only")
+    return noise, None
 
 
 def _static_note(result):

@@ -14,7 +14,7 @@ from pitotcal.core.models import MODELS, get_model
 
 from .jsonfile import read_json
 
-__all__ = ["MAX_ABS_K1", "RECORD_KEYS", "missing_record_keys", "read_result", "record_calibration"]
+__all__ = ["MAX_ABS_K1", "RECORD_KEYS", "check_noise_model", "missing_record_keys", "read_result", "record_calibration"]
 
 # Keys a record holds since the monitor's noise model, the stated GPS error and the reading
 # were added to it.
@@ -114,7 +114,7 @@ def read_result(source, *, name=None, table=True):
     _check_range(label, "noise_std_pa", doc.get("noise_std_pa"), 0.0, math.inf,
                  "a positive noise", low_open=True)
     if doc.get("noise_model") is not None:
-        _check_noise_model(label, doc["noise_model"])
+        check_noise_model(label, doc["noise_model"])
     return dict(doc)
 
 
@@ -127,9 +127,11 @@ _NOISE_BOUNDS = (("block_s", 1e6), ("rel_std", 1.0), ("innovation_rel_std", 1.0)
                  ("std_mps", 50.0), ("innovation_std_mps", 50.0))
 
 
-def _check_noise_model(label, noise):
-    """The record's `noise_model`: positive finite scales within `_NOISE_BOUNDS`, AR
-    coefficients finite and |ar1| < 1."""
+def check_noise_model(label, noise):
+    """A record's `noise_model` (a dict): positive finite scales within `_NOISE_BOUNDS`, AR
+    coefficients finite and |ar1| < 1; a PitotcalError naming `label` and the key otherwise.
+    `identify` holds its own noise model to this rule, so a record it writes is one the
+    monitor reads."""
     for key, upper in _NOISE_BOUNDS:
         if key in noise or key in ("block_s", "rel_std"):
             value = noise.get(key)

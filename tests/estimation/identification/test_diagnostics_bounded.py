@@ -109,3 +109,20 @@ def test_static_products_outside_the_troposphere_have_no_altitude():
     assert all(not np.isfinite(row["dh_ft"]) for row in table)
     assert "dH_pc" in static_source.unavailable_warning(high, table)
     assert "outside the ISA troposphere" in "\n".join(high.summary().splitlines())
+
+
+def test_a_degenerate_monitor_noise_model_is_a_warning_not_a_record_the_monitor_refuses():
+    """identify holds its noise model to the rule `read_result` checks: zero residuals give
+    no noise model and a warning naming it, the result still returned."""
+    import warnings
+
+    from pitotcal.estimation.identification.identify import _monitor_noise
+
+    flight, _ = _flight(0, 0.5)
+    result = pitotcal.identify(flight)
+    assert _monitor_noise(result) == (result.monitor_noise, None)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        noise, note = _monitor_noise(dataclasses.replace(
+            result, residuals_pa=np.zeros_like(result.residuals_pa)))
+    assert noise is None and "noise_model.rel_std" in note
