@@ -256,12 +256,23 @@ def static_table_lines(result, table):
          f"{'ΔH_pc ft':>10}{'±2σ':>7}"),
     ]
     for row in table:
-        lines.append(f"  {row['vi_kt']:7.1f}{row['mach_i']:8.4f}{row['dpp_qcic']:+12.4f}"
-                     f"{row['dpp_qcic_2sigma']:9.4f}{row['dmach']:+9.4f}"
-                     f"{row['dmach_2sigma']:9.5f}{row['dh_ft']:+10.1f}{row['dh_2sigma_ft']:7.1f}"
+        cell = _cell(row)
+        lines.append(f"  {row['vi_kt']:7.1f}{cell('mach_i', 8, '.4f')}"
+                     f"{cell('dpp_qcic', 12, '+.4f')}{cell('dpp_qcic_2sigma', 9, '.4f')}"
+                     f"{cell('dmach', 9, '+.4f')}{cell('dmach_2sigma', 9, '.5f')}"
+                     f"{cell('dh_ft', 10, '+.1f')}{cell('dh_2sigma_ft', 7, '.1f')}"
                      + (f"   δp_T/q_cic {row['dpt_qcic']:+.4f} ±{row['dpt_qcic_2sigma']:.4f}"
                         if "dpt_qcic" in row else ""))
     return lines
+
+
+def _cell(row):
+    """cell(key, width, spec): the row's value formatted, "n/a" where the law gives none."""
+    def cell(key, width, spec):
+        value = row.get(key)
+        text = "n/a" if value is None or not np.isfinite(value) else format(value, spec)
+        return f"{text:>{width}}"
+    return cell
 
 
 def unavailable_warning(result, table):
