@@ -148,3 +148,14 @@ def test_oat_cells_in_celsius_are_named_not_a_mach_error(flown, tmp_path, capsys
         else:
             assert main(["identify", str(path), "--no-budget"]) in (0, None)
             assert "dropped" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("flag", ["--idle-s", "--target-2sigma-kt"])
+def test_identify_live_options_nan_on_a_file(flag, flown, capsys):
+    _refused(["identify", flown[0], flag, "nan", "--no-budget"], capsys, f"{flag} nan")
+
+
+@pytest.mark.parametrize("connection", ["udp:127.0.0.1:0", "tcp:127.0.0.1:65536",
+                                        "udp:localhost"])
+def test_identify_live_connection_without_a_valid_port(connection, capsys):
+    _refused(["identify", "--live", connection], capsys, connection, "1-65535")
