@@ -126,3 +126,20 @@ def test_a_degenerate_monitor_noise_model_is_a_warning_not_a_record_the_monitor_
         noise, note = _monitor_noise(dataclasses.replace(
             result, residuals_pa=np.zeros_like(result.residuals_pa)))
     assert noise is None and "noise_model.rel_std" in note
+
+
+def test_a_budget_term_whose_re_solve_is_refused_is_named_and_the_result_stands(monkeypatch):
+    from pitotcal.core.errors import FlightDataError
+    from pitotcal.estimation.identification import budget
+
+    def refused(flight, result, step):
+        raise FlightDataError("column oat_k: a perturbed value is implausible")
+
+    monkeypatch.setitem(budget.PERTURBATIONS, "oat", refused)
+    flight, _ = _flight(0, 0.5)
+    result = pitotcal.identify(flight, budget=True)
+    assert np.all(np.isnan(result.budget.terms_kt["oat"]))
+    assert np.all(np.isfinite(result.budget.terms_kt["qc_scale"]))
+    record = result.to_dict()
+    assert any("the oat term is not computed" in w for w in record["warnings"])
+    assert record["airspeed_correction"][0]["dv_kt"] is not None
