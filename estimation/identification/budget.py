@@ -44,6 +44,7 @@ import numpy as np
 
 from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
+from pitotcal.core.models import delta_v_kt_where_defined, get_model
 from pitotcal.core.moist_air import moist_density_kgm3
 from pitotcal.core.units import (
     G0_MPS2,
@@ -185,16 +186,28 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
 
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
 
-    def sensitivity(perturb):
-        """u at each speed: the RMS of the re-solves' changes at +u and -u."""
+    def sensitivity(perturb, name):
+        """u at each speed: the RMS of the re-solves' changes at +u and -u; NaN (and a note
+        naming the source) where a re-solve is refused or its ΔV does not exist."""
         dv = []
         for sign in (1.0, -1.0):
-            res = estimate(perturb(sign), **kwargs)
+            try:
+                res = estimate(perturb(sign), **kwargs)
+            except PitotcalError as exc:
+                notes.append(f"uncertainty budget: the {name} term is not computed: its "
+                             f"perturbed re-solve was refused ({exc})")
+                return np.full_like(vi, np.nan)
             if not res.success:
                 notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
                              f"({res.message})")
-            dv.append(np.asarray(res.delta_v_kt(vi)[0], dtype=float) - dv0)
-        return np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
+            dv.append(delta_v_kt_where_defined(get_model(res.model), res.coefficients, vi,
+                                               res.air_data) - dv0)
+        u = np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
+        if not np.all(np.isfinite(u)):
+            notes.append(f"uncertainty budget: the {name} term is not computed at "
+                         f"{int(np.sum(~np.isfinite(u)))} of {vi.size} speeds, where its "
+                         "perturbed calibration has no calibrated airspeed")
+        return u
 
     terms = {}
     for name, field, unit in SOURCES:
@@ -205,10 +218,11 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
             # north and east: V_g + b - W = V_g - (W - b), the fit's wind takes b exactly
             # (the tests re-solve to show it); only the vertical channel is left
             terms[name] = (np.zeros_like(vi) if flight.gps_vd_mps is None else
-                           sensitivity(lambda s, u=u: gps_bias(flight, "gps_vd_mps", s * u)))
+                           sensitivity(lambda s, u=u: gps_bias(flight, "gps_vd_mps", s * u),
+                                       name))
         else:
             perturb = PERTURBATIONS[name]
-            terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u))
+            terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u), name)
     for note in notes:
         warnings.warn(note, stacklevel=2)
     return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,

@@ -138,7 +138,7 @@ def _fit_trimmed(flight, fit, air_data, check=True):
     kept = flight.select(keep) if not keep.all() else flight
     if check:                   # the record's static-error fit, once, before anything uses it
         result = _with_static_fit(result)
-    step_note, found = consistency.check(kept, result, air_data) if result.success and check \
+    step_note, found = _consistency(kept, result, air_data) if result.success and check \
         else ((), {})
     result = dataclasses.replace(result, consistency=found)
     if keep.all():
@@ -148,6 +148,16 @@ def _fit_trimmed(flight, fit, air_data, check=True):
         f"{gates.trim_threshold(flight.n):.1f} sigma of the fitted noise, a false-trim rate of "
         f"{gates.FALSE_TRIM_RATE:g} per flight under Gaussian noise) and the fit repeated "
         f"without them: {gates.spans_text(flight.time_s, ~keep)}"),) + step_note
+
+
+def _consistency(flight, result, air_data):
+    """`consistency.check`, or (its warning, {}) when the data refuse a test: a diagnostic
+    beside the fit never takes the calibration down."""
+    try:
+        return consistency.check(flight, result, air_data)
+    except PitotcalError as exc:
+        return (f"{flight.source}: the consistency checks (step, jump, hidden change) were "
+                f"not computed: {exc}",), {}
 
 
 def _with_static_fit(result):

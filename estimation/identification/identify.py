@@ -8,8 +8,10 @@ import dataclasses
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA
+from pitotcal.io.result_record import check_noise_model
 
 from ..uncertainty.block_noise import block_residual_stats
+from . import static_source
 from .budget import BudgetInputs, uncertainty_budget
 from .fit import (
     MAX_CORRELATION,
@@ -20,6 +22,7 @@ from .fit import (
     fit,
     track_spread_deg,
 )
+from .view import correction_table
 
 __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG",
            "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
@@ -132,10 +135,7 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
     gps_error : (sigma_mps, tau_s)
         The stated GPS velocity error (None, None: none stated).
     """
-    try:
-        noise = block_residual_stats(result)
-    except PitotcalError:               # too short a record for the monitor's blocks
-        noise = None
+    noise, noise_note = _monitor_noise(result)
     reading = getattr(flight, "reading", None)
     sigma, tau = gps_error
     result = dataclasses.replace(
@@ -143,6 +143,42 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
         gps_error={"stated": sigma is not None, "sigma_mps": sigma, "tau_s": tau},
         reading=None if reading is None else dict(reading), source=str(flight.source),
         n_dropped=int(flight.n_dropped))
+    result = _with_warning(_with_warning(result, noise_note), _static_note(result))
     if budget is None:
         return result
-    return dataclasses.replace(result, budget=uncertainty_budget(flight, result, budget, air=air))
+    try:
+        return dataclasses.replace(
+            result, budget=uncertainty_budget(flight, result, budget, air=air))
+    except PitotcalError as exc:        # the calibration stands without its budget
+        return _with_warning(result, f"{result.source}: the uncertainty budget was not "
+                                     f"computed: {exc}")
+
+
+def _monitor_noise(result):
+    """(the residuals' noise model for `pitotcal monitor`, or None; a warning or None): None
+    without a warning for a record too short for the monitor's blocks, with one when the
+    model is degenerate (a zero or non-finite scale the monitor could not test against)."""
+    try:
+        noise = block_residual_stats(result)
+    except PitotcalError:               # too short a record for the monitor's blocks
+        return None, None
+    try:
+        check_noise_model("noise_model", noise)
+    except PitotcalError as exc:
+        return None, (f"{result.source}: the monitor's noise model was not computed ({exc}); "
+                      "the record carries noise_std_pa only")
+    return noise, None
+
+
+def _static_note(result):
+    """The warning naming the static-source products the record cannot hold, or None."""
+    if result.air_data != "compressible" or result.ps_pa is None:
+        return None
+    return static_source.unavailable_warning(result, correction_table(result))
+
+
+def _with_warning(result, note):
+    """`result` with `note` added to its warnings (None: unchanged)."""
+    if not note or note in result.warnings:
+        return result
+    return dataclasses.replace(result, warnings=tuple(result.warnings) + (note,))

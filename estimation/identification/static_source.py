@@ -20,6 +20,10 @@ error is measured, Δp_p = p_s,ind − p_s,ref, and fitted by the same structure
 Δp_p / q_c = f(q_ci; k_s) (`static_error_fit`, least squares with the colored-residual
 covariance); the total-pressure error is the rest, δp_T = p_T,ind − p_T = Δp_p − (q_c − q_ci).
 ΔM_pc and ΔH_pc then use the measured static error, and the rows add δp_T / q_cic.
+
+Each product exists only where its law does: Mach below 1 and pressure altitudes in the ISA
+troposphere. Elsewhere it is NaN (null in the JSON) and `unavailable_warning` names it, so a
+calibration far out (a short or rough record) is still returned with what can be computed.
 """
 
 import numpy as np
@@ -32,7 +36,8 @@ from pitotcal.core.units import kt_to_mps, m_to_ft
 __all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "fitted_static_error",
            "plot_altimeter_correction",
            "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",
-           "static_source_products", "static_statement", "static_table_lines"]
+           "static_source_products", "static_statement", "static_table_lines",
+           "unavailable_warning"]
 
 ASSUMED_STATIC = ("all pressure error in the static source: total pressure exact, "
                   "dp_p = q_c - q_ci = p_s,ind - p_s")
@@ -45,7 +50,34 @@ def pressure_altitude_ic_m(result):
     """The flight's median indicated pressure altitude H_ic, m (None without `ps_pa`)."""
     if result.ps_pa is None:
         return None
-    return float(airdata.pressure_altitude_m(np.median(result.ps_pa)))
+    ps = float(np.median(result.ps_pa))
+    return float(airdata.pressure_altitude_m(ps)) if _in_troposphere(ps) else None
+
+
+def _in_troposphere(ps_pa):
+    """Where `airdata.pressure_altitude_m` is defined (numpy bool, the shape of `ps_pa`)."""
+    lo, hi = (float(airdata.static_pressure_pa(h)) for h in (airdata.PRESSURE_ALTITUDE_MAX_M,
+                                                             airdata.PRESSURE_ALTITUDE_MIN_M))
+    ps = np.asarray(ps_pa, dtype=float)
+    return np.isfinite(ps) & (ps >= lo) & (ps <= hi)
+
+
+def _subsonic(qc_pa, ps_pa):
+    """Where `airdata.mach_from_qc` is defined: |q_c| / p_s up to Mach 1."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.abs(qc_pa) / ps_pa
+    return np.isfinite(ratio) & (np.asarray(ps_pa) > 0) \
+        & (ratio <= airdata.QC_SONIC_PA / airdata.P0_PA)
+
+
+def _on(ok, fun, *args):
+    """fun(*args) where `ok`, NaN elsewhere (each arg broadcast to ok's shape)."""
+    ok = np.asarray(ok, dtype=bool)
+    out = np.full(ok.shape, np.nan)
+    if ok.any():
+        out[ok] = fun(*(np.broadcast_to(np.asarray(a, dtype=float), ok.shape)[ok]
+                        for a in args))
+    return out
 
 
 def static_error_fit(result):
@@ -84,13 +116,15 @@ def _products(model, kk, vi_kt, ps_ind_pa, n_k):
     """
     k, k_static = kk[:n_k], kk[n_k:]
     qci = airdata.qc_from_cas_pa(kt_to_mps(np.asarray(vi_kt, dtype=float)))
-    qc = qc_from_qci_pa(model, k, qci)
-    dp = qc - qci if k_static.size == 0 else qc * model(k_static, qci)
-    mach_i = airdata.mach_from_qc(qci, ps_ind_pa)
-    dmach = airdata.mach_from_qc(qc, ps_ind_pa - dp) - mach_i
-    h_ic = airdata.pressure_altitude_m(ps_ind_pa)
-    return (dp / qci, mach_i, dmach, airdata.altimeter_correction_m(dp, h_ic),
-            (dp - (qc - qci)) / qci)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        qc = qc_from_qci_pa(model, k, qci)
+        dp = qc - qci if k_static.size == 0 else qc * model(k_static, qci)
+    ps = ps_ind_pa - dp
+    mach_i = _on(_subsonic(qci, ps_ind_pa), airdata.mach_from_qc, qci, ps_ind_pa)
+    dmach = _on(_subsonic(qc, ps), airdata.mach_from_qc, qc, ps) - mach_i
+    dh = _on(_in_troposphere(ps) & _in_troposphere(ps_ind_pa), lambda d: (
+        airdata.altimeter_correction_m(d, airdata.pressure_altitude_m(ps_ind_pa))), dp)
+    return dp / qci, mach_i, dmach, dh, (dp - (qc - qci)) / qci
 
 
 def static_source_products(result, vi_kt, plain=False):
@@ -128,7 +162,8 @@ def static_source_products(result, vi_kt, plain=False):
     out = {"dpp_qcic": values[0], "dpp_qcic_2sigma": bands[0], "mach_i": values[1],
            "dmach": values[2], "dmach_2sigma": bands[1], "dh_ft": m_to_ft(values[3]),
            "dh_2sigma_ft": m_to_ft(bands[2]),
-           "pressure_altitude_ic_ft": float(m_to_ft(airdata.pressure_altitude_m(ps_ind)))}
+           "pressure_altitude_ic_ft": (float(m_to_ft(airdata.pressure_altitude_m(ps_ind)))
+                                       if _in_troposphere(ps_ind) else None)}
     if reference:
         out.update(dpt_qcic=values[4], dpt_qcic_2sigma=bands[3], k_static=kk[n_k:],
                    k_static_std=np.sqrt(np.diag(cov[n_k:, n_k:])))
@@ -177,9 +212,11 @@ def plot_altimeter_correction(ax, result, vi_range_kt):
     dh, band = grid["dh_ft"], grid["dh_2sigma_ft"]
     ax.fill_between(vi, dh - band, dh + band, color="tab:green", alpha=0.3, label="2σ")
     ax.plot(vi, dh, color="tab:green", lw=2, label="ΔH_pc = H_c − H_ic")
+    h_ic = grid["pressure_altitude_ic_ft"]
     ax.set(xlabel="indicated airspeed V_i (kt)", ylabel="ΔH_pc (ft)",
-           title=f"Altimeter correction at {grid['pressure_altitude_ic_ft']:.0f} ft "
-                 "pressure altitude")
+           title="Altimeter correction " + ("not defined outside the ISA troposphere"
+                                            if h_ic is None else
+                                            f"at {h_ic:.0f} ft pressure altitude"))
     ax.legend(fontsize=8, loc="best")
 
 
@@ -209,17 +246,51 @@ def air_data_lines(result):
 def static_table_lines(result, table):
     """Static-source position error per row: Δp_p/q_cic, M_ic, ΔM_pc, ΔH_pc with 2σ."""
     h_ic = pressure_altitude_ic_m(result)
+    where = ("outside the ISA troposphere: no altimeter correction" if h_ic is None
+             else f"{m_to_ft(h_ic):.0f} ft")
     lines = [
         "",
         (f"Static-source position error (altimeter correction at the flight's median pressure "
-         f"altitude {m_to_ft(h_ic):.0f} ft):"),
+         f"altitude {where}):"),
         (f"  {'KIAS':>7}{'M_ic':>8}{'Δp_p/q_cic':>12}{'±2σ':>9}{'ΔM_pc':>9}{'±2σ':>9}"
          f"{'ΔH_pc ft':>10}{'±2σ':>7}"),
     ]
     for row in table:
-        lines.append(f"  {row['vi_kt']:7.1f}{row['mach_i']:8.4f}{row['dpp_qcic']:+12.4f}"
-                     f"{row['dpp_qcic_2sigma']:9.4f}{row['dmach']:+9.4f}"
-                     f"{row['dmach_2sigma']:9.5f}{row['dh_ft']:+10.1f}{row['dh_2sigma_ft']:7.1f}"
+        cell = _cell(row)
+        lines.append(f"  {row['vi_kt']:7.1f}{cell('mach_i', 8, '.4f')}"
+                     f"{cell('dpp_qcic', 12, '+.4f')}{cell('dpp_qcic_2sigma', 9, '.4f')}"
+                     f"{cell('dmach', 9, '+.4f')}{cell('dmach_2sigma', 9, '.5f')}"
+                     f"{cell('dh_ft', 10, '+.1f')}{cell('dh_2sigma_ft', 7, '.1f')}"
                      + (f"   δp_T/q_cic {row['dpt_qcic']:+.4f} ±{row['dpt_qcic_2sigma']:.4f}"
                         if "dpt_qcic" in row else ""))
     return lines
+
+
+def _cell(row):
+    """cell(key, width, spec): the row's value formatted, "n/a" where the law gives none."""
+    def cell(key, width, spec):
+        value = row.get(key)
+        text = "n/a" if value is None or not np.isfinite(value) else format(value, spec)
+        return f"{text:>{width}}"
+    return cell
+
+
+def unavailable_warning(result, table):
+    """The warning naming the static-source products the law does not give at some rows of
+    `table` (`correction_table`'s rows of a compressible result), or None."""
+    names = {"mach_i": "M_ic", "dmach": "dM_pc", "dh_ft": "dH_pc"}
+    missing = {}
+    for row in table:
+        for key, name in names.items():
+            value = row.get(key)
+            if key in row and (value is None or not np.isfinite(value)):
+                missing.setdefault(name, []).append(row["vi_kt"])
+    if not missing:
+        return None
+    parts = [f"{name} at {len(vi)} of {len(table)} rows ({min(vi):.0f}-{max(vi):.0f} kt)"
+             for name, vi in missing.items()]
+    h_ic = pressure_altitude_ic_m(result)
+    return (f"{result.source}: static-source products not computed: {'; '.join(parts)}: "
+            "the calibration puts the static pressure there beyond Mach 1 or outside the "
+            "ISA troposphere" + (" (the flight's median static pressure is outside it)"
+                                 if h_ic is None else "") + "; the airspeed correction stands")

@@ -96,7 +96,9 @@ def detect_segments(flight, min_leg_s=30.0, track_tol_deg=3.0, groundspeed_tol_k
         (start_s, end_s) of each segment, in time order.
     """
     t0, vn, ve, ias = _second_means(flight)
-    n = max(1, round(float(smooth_s)))
+    # at most the record's own length in 1 s bins: a longer window smooths nothing more
+    # (and no segment then fits in the record), but would cost its length in memory
+    n = max(1, min(round(float(smooth_s)), t0.size))
     vn, ve, ias = _smooth(vn, n), _smooth(ve, n), _smooth(ias, n)
     gs = np.hypot(vn, ve) / KT_TO_MPS
     track = np.degrees(np.arctan2(ve, vn))

@@ -194,7 +194,8 @@ def fit_legs(legs, model="inverse", wind="per-band", initial_winds=None):
     scales = np.asarray(pe.scales, dtype=float)
     g = legs.velocity_ne_mps()
     ps_ind = airdata.static_pressure_pa(legs.pressure_alt_m)
-    stated = bool(np.all(np.isfinite(legs.groundspeed_sd_mps)))
+    # a zero accuracy would weigh a leg infinitely: no statement, like a missing one
+    stated = bool(np.all(np.isfinite(legs.groundspeed_sd_mps) & (legs.groundspeed_sd_mps > 0)))
     sigma = legs.groundspeed_sd_mps if stated else np.ones(legs.n)
     _check_counts(legs, nk, ng, wind, stated)
 

@@ -57,6 +57,15 @@ def read_aircraft(path):
             doc = tomllib.load(f)
     except tomllib.TOMLDecodeError as exc:
         raise PitotcalError(f"`aircraft_path` {path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML (binary content, not "
+                            "UTF-8 text)") from None
+    except RecursionError:
+        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML (nested too deeply)") \
+            from None
+    except OSError as exc:
+        raise PitotcalError(f"`aircraft_path` {path}: cannot read it ({exc.strerror})") \
+            from None
     rows, seen = [], set()
     for table, key, label in AIRCRAFT_FIELDS:
         value = doc.get(table, {}).get(key) if isinstance(doc.get(table), dict) else None

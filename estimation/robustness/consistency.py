@@ -22,7 +22,7 @@ import numpy as np
 
 from pitotcal.core.information import normal_isf
 from pitotcal.core.measurement import flight_channels, sensitivities
-from pitotcal.core.models import delta_v_kt, get_model
+from pitotcal.core.models import delta_v_kt, delta_v_kt_where_defined, get_model
 
 from ..uncertainty.covariance import colored_covariance
 from ..uncertainty.residual_noise import block_means
@@ -128,11 +128,21 @@ def hidden_warning(source, details):
             f"icing, drift) hides in the calibration: one from about t = "
             f"{hidden['onset_s']:.0f} s on is caught in {100 * POWER:.0f}% of flights only from "
             f"{100 * hidden['step']:.1f}% up, and one of that size moves dV by "
-            f"{hidden['dv_shift_kt']:.2f} kt at {hidden['vi_kt']:.0f} kt, "
+            f"{hidden['dv_shift_kt']:.2f} kt at {hidden['vi_kt']:.0f} kt{_first_order(hidden)}, "
             f"{hidden['dv_shift_kt'] / hidden['dv_2sigma_reported_kt']:.1f} times the 2-sigma "
             "band the result reports there; fly "
             "the speeds twice (plan a return sweep: up and back down the speed range) to tell "
             "the two apart")
+
+
+def _first_order(hidden):
+    """The warning's note when the shifted calibration has no V_c at some flown speeds."""
+    speeds = hidden.get("first_order_vi_kt") or []
+    if not speeds:
+        return ""
+    return (f" (to first order at {len(speeds)} of the table's speeds, "
+            f"{min(speeds):.0f}-{max(speeds):.0f} kt, where it puts q_c beyond the "
+            "subsonic range)")
 
 
 def _scan(jac, r, qci, first, threshold):
@@ -192,6 +202,17 @@ def _tail(x):
     return np.cumsum(x[::-1], axis=0)[::-1]
 
 
+def _dv_shift_kt(model, k_shifted, vi_kt, dv_fit_kt, first_order_kt, air_data):
+    """(|ΔV shift|, kt, and where it is first order): the shifted calibration's ΔV against
+    the fit's at each speed where it exists (`delta_v_kt_where_defined`), the first-order
+    shift `first_order_kt` where it does not (a missed step large enough to push q_c past the
+    subsonic range is hidden all the same, and is not a reason to refuse the flight)."""
+    dv = np.abs(dv_fit_kt - delta_v_kt_where_defined(model, k_shifted, vi_kt, air_data))
+    linear = ~np.isfinite(dv)
+    dv[linear] = np.abs(first_order_kt[linear])
+    return dv, linear
+
+
 def _undetected(result, model, onsets, scan, z_detect):
     """The onset where the smallest detected step, z_detect sigma, moves ΔV most against
     its 2-sigma band, and the numbers.
@@ -229,9 +250,10 @@ def _undetected(result, model, onsets, scan, z_detect):
         size = z_detect * scan["plain"][i] * np.sqrt(inflation)
         off = [scan["shift"][i, :nk] * size,                                   # from before
                (scan["shift"][i, :nk] - scan["shift_all"][:nk]) * size]        # from after
-        dv = [np.abs(dv_fit - delta_v_kt(model, k - dk, vi, result.air_data)) for dk in off]
-        pick = int(np.argmin([np.max(d / band) for d in dv]))
-        dk, dv = off[pick], dv[pick]
+        shifts = [_dv_shift_kt(model, k - dk, vi, dv_fit, dk @ grad, result.air_data)
+                  for dk in off]
+        pick = int(np.argmin([np.max(d / band) for d, _ in shifts]))
+        dk, (dv, linear) = off[pick], shifts[pick]
         j = int(np.argmax(dv / band))
         if best is None or dv[j] / band[j] > best[0]:
             k_sigma = float(np.sqrt(max(dk @ np.linalg.solve(cov_k, dk), 0.0)))
@@ -240,5 +262,8 @@ def _undetected(result, model, onsets, scan, z_detect):
                 "dv_shift_kt": float(dv[j]), "dv_2sigma_kt": float(band[j]),
                 "vi_kt": float(vi[j]), "k_shift_sigma": k_sigma,
                 # the band printed in the result's table at that speed (the warning's ratio)
-                "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"])})
+                "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"]),
+                # speeds where the shifted calibration has no V_c (beyond the subsonic
+                # range): its shift there is the first-order one
+                "first_order_vi_kt": [float(v) for v in vi[linear]]})
     return best[1]

@@ -53,8 +53,10 @@ def announce_stream(command, connection, idle_s):
     """One stderr line as a live MAVLink stream starts: where it listens, how long it waits."""
     import sys
 
-    from pitotcal.io.mavlink_live import FIRST_MESSAGE_TIMEOUT_S, LISTENING_PREFIXES
+    from pitotcal.io.mavlink_live import (
+        FIRST_MESSAGE_TIMEOUT_S, LISTENING_PREFIXES, check_connection)
 
+    check_connection(connection)
     how = "listening on" if str(connection).startswith(LISTENING_PREFIXES) else "connecting to"
     print(f"pitotcal {command}: {how} {connection} for MAVLink (up to "
           f"{FIRST_MESSAGE_TIMEOUT_S:g} s for the first message, then ends after {idle_s:g} s "
@@ -113,6 +115,9 @@ def _as_written(path, figure):
 def _check_one(flag, out, inputs):
     from pitotcal.core.errors import PitotcalError
 
+    if str(out) == "-":                 # stdout carries the summary: no JSON mixed into it
+        raise PitotcalError(f"{flag} -: an output here is a file, not stdout (which carries "
+                            "the summary): give a file name")
     if out.is_dir():
         raise PitotcalError(f"{flag} {out} is a folder: give the file to write")
     for source, what in inputs:

@@ -152,6 +152,13 @@ def _budget_inputs(args):
 
 
 def run(args):
+    from pitotcal.core.checks import positive
+
+    from .common import idle_timeout_s
+
+    # the live options are checked with a file too: a NaN is no option anywhere
+    idle_timeout_s(args.idle_s)
+    positive("target_2sigma_kt", args.target_2sigma_kt)
     if args.live is not None or args.flight is None:
         return _run_live(args)
     import warnings

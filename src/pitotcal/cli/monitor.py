@@ -102,8 +102,9 @@ def run(args):
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(**{name: getattr(args, name) for name in _DESIGN_FLAGS
                              if getattr(args, name) is not None}).checked()
+    idle_s = idle_timeout_s(args.idle_s)        # checked for a file too: NaN is no option
     if is_connection(args.source):
-        oat_k, idle_s = oat_k_from_c(args.oat_c), idle_timeout_s(args.idle_s)
+        oat_k = oat_k_from_c(args.oat_c)
         announce_stream("monitor", args.source, idle_s)
         result, buf = monitor_stream(args.source, cal, opts, oat_k=oat_k, idle_timeout_s=idle_s,
                                      on_status=lambda text: print(text, file=sys.stderr))

@@ -43,6 +43,7 @@ __all__ = [
     "P0_PA",
     "PRESSURE_ALTITUDE_MAX_M",
     "PRESSURE_ALTITUDE_MIN_M",
+    "QC_SONIC_PA",
     "RHO0_KGM3",
     "T0_K",
     "airspeed_law",
@@ -72,6 +73,8 @@ PRESSURE_ALTITUDE_MIN_M = -2000.0 * FT_TO_M
 PRESSURE_ALTITUDE_MAX_M = 11000.0
 
 _QC_OVER_P_SONIC = (1.0 + 0.2) ** 3.5 - 1.0         # 0.8929: q_c/p at M = 1
+# The largest impact pressure the calibrated-airspeed law takes (V_c = a0), Pa.
+QC_SONIC_PA = _QC_OVER_P_SONIC * P0_PA
 
 
 def _numeric(lib):
@@ -231,7 +234,7 @@ def cas_from_qc_mps(qc_pa, lib=np):
     """
     (qc_pa,) = _floats(lib, qc_pa)
     if _numeric(lib):
-        _refuse_outside("qc_pa", np.abs(qc_pa), 0.0, _QC_OVER_P_SONIC * P0_PA,
+        _refuse_outside("qc_pa", np.abs(qc_pa), 0.0, QC_SONIC_PA,
                         "the subsonic range")
     return A0_MPS * mach_from_qc(qc_pa, P0_PA, lib)
 

@@ -26,11 +26,12 @@ _POSITIVE = ("qc_pa", "rho_kgm3", "ps_pa", "oat_k", "ps_ref_pa")
 # glitch, a corrupt cell): unusable like NaN. GNSS receivers stop reporting velocity above
 # 515 m/s (the COCOM limit, 1000 kt); 2e5 Pa is the impact pressure of Mach 1.6 at sea level;
 # 2.5 kg/m^3 and 1.2e5 Pa are beyond any air at any airfield (ISA -90 degC at 1.08 bar is
-# 2.05 kg/m^3); 400 K is 127 degC.
+# 2.05 kg/m^3); 400 K is 127 degC, and 150 K (-123 degC) is colder than any air flown in
+# (the coldest measured is about -90 degC), so a cell below it is a degC value among kelvin.
 PLAUSIBLE = {"qc_pa": (0.0, 2e5), "gps_vn_mps": (-515.0, 515.0),
              "gps_ve_mps": (-515.0, 515.0), "gps_vd_mps": (-515.0, 515.0),
              "rho_kgm3": (0.0, 2.5), "ps_pa": (0.0, 1.2e5), "ps_ref_pa": (0.0, 1.2e5),
-             "oat_k": (0.0, 400.0), "alt_m": (-1000.0, 1e5)}
+             "oat_k": (150.0, 400.0), "alt_m": (-1000.0, 1e5)}
 
 # Unit diagnosis (see the flight_csv module docstring). q_ci / (0.5 rho |V_g|^2) of a flying
 # aircraft is 1 / (1 + (W/V)^2) on a full circle and at worst (1 -/+ W/V)^-2 on one leg:

@@ -55,5 +55,8 @@ def read_json(path, name=None):
     except UnicodeDecodeError:
         raise PitotcalError(f"{label}: not JSON (binary content); not a JSON file pitotcal "
                             "wrote") from None
+    except RecursionError:
+        raise PitotcalError(f"{label}: JSON nested too deeply to read; not a JSON file "
+                            "pitotcal wrote") from None
     except OSError as exc:
         raise PitotcalError(f"{label}: cannot read it ({exc.strerror})") from None

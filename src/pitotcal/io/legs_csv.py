@@ -49,6 +49,8 @@ _RANGES = {
     "duration_s": (0.0, 3600.0, ""),
     "groundspeed_sd_kt": (0.0, 50.0, ""),
 }
+# ... of which zero is not a value either
+_POSITIVE = ("groundspeed_sd_kt",)
 
 
 @dataclass(frozen=True)
@@ -246,6 +248,9 @@ def _column(col, header, rows, lines, name, optional=False):
         if not lo <= x <= hi:
             raise FlightDataError(f"{where}: {x:g} is outside {lo:g} to {hi:g}"
                                   f"{hint or _unit_hint(col, x)}")
+        if col in _POSITIVE and x == 0.0:
+            raise FlightDataError(f"{where}: 0 is no accuracy (the legs would weigh "
+                                  "infinitely); give the GPS's, or leave the cell empty")
         out[r] = x
     return out
 

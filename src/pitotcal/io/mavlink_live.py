@@ -26,7 +26,8 @@ from pitotcal.core.flight import Flight
 from pitotcal.core.units import density_kgm3
 
 __all__ = ["CONNECTION_PREFIXES", "FIRST_MESSAGE_TIMEOUT_S", "IDLE_TIMEOUT_S",
-           "LISTENING_PREFIXES", "MavlinkFlightBuffer", "is_connection", "read_stream"]
+           "LISTENING_PREFIXES", "MavlinkFlightBuffer", "check_connection", "is_connection",
+           "read_stream"]
 
 CONNECTION_PREFIXES = ("udp:", "udpin:", "udpout:", "tcp:", "tcpin:")
 # pymavlink's connections that wait for the sender (the others connect to it)
@@ -103,9 +104,21 @@ class MavlinkFlightBuffer:
                       warnings=tuple(self.warnings()))
 
 
+def check_connection(source):
+    """`source` if it is a connection string with a host and a port 1-65535; a one-line
+    PitotcalError naming it otherwise (the socket layer would raise OverflowError)."""
+    address = str(source).split(":", 1)[1] if ":" in str(source) else ""
+    host, _, port = address.rpartition(":")
+    if not host or not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise PitotcalError(f"{source}: not a MAVLink connection HOST:PORT with a port "
+                            "1-65535 (e.g. udp:127.0.0.1:14550)", param="source")
+    return source
+
+
 def _connect(source):
     from pymavlink import mavutil
 
+    check_connection(source)
     try:
         conn = mavutil.mavlink_connection(str(source))
     except (OSError, ValueError) as exc:

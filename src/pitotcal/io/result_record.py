@@ -14,7 +14,7 @@ from pitotcal.core.models import MODELS, get_model
 
 from .jsonfile import read_json
 
-__all__ = ["RECORD_KEYS", "missing_record_keys", "read_result", "record_calibration"]
+__all__ = ["MAX_ABS_K1", "RECORD_KEYS", "check_noise_model", "missing_record_keys", "read_result", "record_calibration"]
 
 # Keys a record holds since the monitor's noise model, the stated GPS error and the reading
 # were added to it.
@@ -109,7 +109,58 @@ def read_result(source, *, name=None, table=True):
         entry = doc["parameters"].get(par)
         _check_type(label, f"parameters.{par}", entry, dict, "an object with a value")
         _check_number(label, f"parameters.{par}.value", entry, "value")
+    _check_range(label, "parameters.k1.value", doc["parameters"]["k1"]["value"], -MAX_ABS_K1,
+                 MAX_ABS_K1, "a pressure-error ratio (|k1| < 0.5)")
+    _check_range(label, "noise_std_pa", doc.get("noise_std_pa"), 0.0, math.inf,
+                 "a positive noise", low_open=True)
+    if doc.get("noise_model") is not None:
+        check_noise_model(label, doc["noise_model"])
     return dict(doc)
+
+
+# The pressure-error ratio dp/q_c of any working pitot-static system is a few percent; 0.5
+# (half the impact pressure lost) is beyond any calibration a flight could support.
+MAX_ABS_K1 = 0.5
+# The noise model's scales (relative to q_ci; m/s): positive, finite and below these bounds
+# (a residual as large as q_ci itself, or 50 m/s of airspeed, is no calibration's noise).
+_NOISE_BOUNDS = (("block_s", 1e6), ("rel_std", 1.0), ("innovation_rel_std", 1.0),
+                 ("std_mps", 50.0), ("innovation_std_mps", 50.0))
+
+
+def check_noise_model(label, noise):
+    """A record's `noise_model` (a dict): positive finite scales within `_NOISE_BOUNDS`, AR
+    coefficients finite and |ar1| < 1; a PitotcalError naming `label` and the key otherwise.
+    `identify` holds its own noise model to this rule, so a record it writes is one the
+    monitor reads."""
+    for key, upper in _NOISE_BOUNDS:
+        if key in noise or key in ("block_s", "rel_std"):
+            value = noise.get(key)
+            _check_type(label, f"noise_model.{key}", value, _NUMBER, "a number")
+            _check_range(label, f"noise_model.{key}", value, 0.0, upper,
+                         f"a positive noise scale up to {upper:g}", low_open=True)
+    if "ar1" in noise:
+        _check_type(label, "noise_model.ar1", noise["ar1"], _NUMBER, "a number")
+        _check_range(label, "noise_model.ar1", noise["ar1"], -1.0, 1.0,
+                     "an AR(1) coefficient, |ar1| < 1", low_open=True, high_open=True)
+    for key in ("ar", "ar_mps"):
+        values = noise.get(key, [])
+        _check_type(label, f"noise_model.{key}", values, list, "a list of numbers")
+        for i, value in enumerate(values):
+            _check_type(label, f"noise_model.{key}[{i}]", value, _NUMBER, "a number")
+            _check_range(label, f"noise_model.{key}[{i}]", value, -math.inf, math.inf,
+                         "a finite number")
+
+
+def _check_range(label, key, value, lo, hi, what, low_open=False, high_open=False):
+    """A number `value` (None passes: a null the reader of that key handles) finite and in
+    [lo, hi] (open at an end when asked); a PitotcalError naming `key` otherwise."""
+    if value is None:
+        return
+    x = float(value)
+    if not math.isfinite(x) or x < lo or x > hi or (low_open and x == lo) \
+            or (high_open and x == hi):
+        raise PitotcalError(f"{label}: key '{key}' is {value!r}, not {what}: the record is "
+                            "not a usable calibration", param=key)
 
 
 def _check_type(label, key, value, types, what):
@@ -125,6 +176,10 @@ def _check_number(label, key, entry, field):
     if field not in entry:
         raise PitotcalError(f"{label}: not a pitotcal identify result JSON (no key '{key}')")
     _check_type(label, key, entry[field], (*_NUMBER, type(None)), "a number")
+    # JSON has no NaN or Infinity; Python's parser reads them, pitotcal writes null
+    if entry[field] is not None and not math.isfinite(entry[field]):
+        raise PitotcalError(f"{label}: key '{key}' is {entry[field]!r}, not a finite number "
+                            "(null where a value is missing)", param=key)
 
 
 def _json_type(value):
