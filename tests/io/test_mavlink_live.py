@@ -16,6 +16,10 @@ from plans import circle_plan
 from pitotcal.core.errors import FlightDataError
 from pitotcal.io.mavlink_live import FIRST_MESSAGE_TIMEOUT_S, MavlinkFlightBuffer, read_stream
 
+# The monitor designs its tests before it listens (0.2-0.7 s on a loaded machine): UDP sent
+# before that is lost, so its senders start later than the default 0.3 s.
+MONITOR_DELAY_S = 1.5
+
 pytest.importorskip("pymavlink")
 
 
@@ -31,7 +35,7 @@ def flights():
 def test_monitor_stream_equals_file(flights):
     cal, flight = flights
     port = free_udp_port()
-    send_flight(flight, port)
+    send_flight(flight, port, delay_s=MONITOR_DELAY_S)
     live, buf = monitor_stream(f"udpin:127.0.0.1:{port}", cal, idle_timeout_s=1.0,
                                oat_k=None)
     assert buf.n == flight.n and buf.n_out_of_order == 0
@@ -115,7 +119,7 @@ def test_sitl_log_replayed_as_mavlink(shared_file, tmp_path, capsys):
     for name, source in (("file", str(csv)), ("live", None)):
         if source is None:
             port = free_udp_port()
-            send_flight(sent, port)
+            send_flight(sent, port, delay_s=MONITOR_DELAY_S)
             source = f"udpin:127.0.0.1:{port}"
         codes.append(main(["monitor", source, "--calibration", str(tmp_path / "file.json"),
                            "--idle-s", "1", "--json", str(tmp_path / f"{name}.mon.json")]))
@@ -141,7 +145,7 @@ def test_monitor_cli_on_a_stream(flights, tmp_path, capsys):
                                                                 -cal.wind_n_mps)) % 360)}},
         "noise_model": cal.noise})
     port = free_udp_port()
-    send_flight(flight, port)
+    send_flight(flight, port, delay_s=MONITOR_DELAY_S)
     code = main(["monitor", f"udpin:127.0.0.1:{port}", "--calibration", str(cal_json),
                  "--idle-s", "1"])
     out, err = capsys.readouterr()
