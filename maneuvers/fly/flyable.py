@@ -6,7 +6,7 @@ import numpy as np
 
 from pitotcal.core.checks import exact, round_to_limit
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.models import get_model
+from pitotcal.core.models import MAX_PRESSURE_ERROR, get_model
 from pitotcal.core.plan import Plan
 
 __all__ = ["MAX_PRESSURE_ERROR", "MAX_SAMPLES", "MIN_SAMPLES", "check_plan", "check_pressure_error",
@@ -34,9 +34,6 @@ def check_plan(plan):
         raise PitotcalError("plan airspeeds must be > 0")
 
 
-# The largest pressure error simulated, |dp/q_c| (beyond it the sensor would read
-# zero or negative impact pressure: no pitot-static system).
-MAX_PRESSURE_ERROR = 0.5
 
 
 def check_pressure_error(opts, plan):

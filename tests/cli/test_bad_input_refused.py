@@ -89,7 +89,7 @@ def test_monitor_idle_s_nan_on_a_file(flown, capsys):
 def test_plan_calibration_k1_099(flown, tmp_path, capsys):
     cal = _edited(flown, tmp_path, _set(("parameters", "k1", "value"), 0.99))
     _refused(["plan", "--calibration", cal, "-o", tmp_path / "p.csv"], capsys,
-             "parameters.k1.value", "|k1| < 0.5")
+             "parameters.k1.value", "|dp/qc| reaches 0.98")
 
 
 def test_plan_target_2sigma_nan(tmp_path, capsys):

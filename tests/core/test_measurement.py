@@ -184,3 +184,15 @@ def test_default_air_data_is_the_standard_relation():
     assert DEFAULT_AIR_DATA == "compressible" and DEFAULT_AIR_DATA in AIR_DATA_MODES
     assert ad.qc_from_tas_pa(50.0, 101325.0, 288.15) == pytest.approx(
         StaticAir(101325.0, 288.15).qc_pa(2500.0), rel=1e-15)
+
+
+@pytest.mark.parametrize("air", [StaticAir(101325.0, 288.15), TotalPressureAir(103325.0, 288.15)])
+def test_numeric_air_takes_a_symbolic_speed(air):
+    """Numbers in the air data and a CasADi symbol for V_t² build the same q_c as numpy."""
+    import casadi as ca
+
+    v2 = ca.MX.sym("v2")
+    f = ca.Function("f", [v2], [air.qc_pa(v2), air.derivatives(v2)[0]])
+    qc, slope = (float(x) for x in f(2500.0))
+    assert qc == pytest.approx(float(air.qc_pa(2500.0)), rel=1e-12)
+    assert slope == pytest.approx(float(air.derivatives(2500.0)[0]), rel=1e-12)

@@ -110,3 +110,23 @@ def test_with_static_air_untouched_and_refusals():
         rh = np.full(20, 50.0)
         rh[2] = 130.0
         ma.with_static_air(_flight(ps_pa=np.full(20, 9e4), oat_k=np.full(20, 280.0), rh_pct=rh))
+
+
+def test_a_flight_written_after_reading_reads_back_the_same(tmp_path):
+    """A converted flight written out carries its virtual oat_k (`# oat_k_is`): read again,
+    the humidity is not applied twice (the density stays the first read's)."""
+    import pitotcal
+
+    n = 200
+    ang = np.linspace(0.0, 2 * np.pi, n)
+    rows = ["time_s,qc_pa,gps_vn_mps,gps_ve_mps,ps_pa,oat_k,rh_pct"]
+    rows += [f"{0.1 * i:.2f},{1500 + 100 * np.sin(a):.3f},{50 * np.cos(a):.4f},"
+             f"{50 * np.sin(a):.4f},95000,303.15,80" for i, a in enumerate(ang)]
+    (tmp_path / "humid.csv").write_text("\n".join(rows) + "\n")
+    first = pitotcal.read_flight(tmp_path / "humid.csv")
+    pitotcal.write_flight_csv(first, tmp_path / "again.csv")
+    again = pitotcal.read_flight(tmp_path / "again.csv")
+    np.testing.assert_allclose(again.rho_kgm3, first.rho_kgm3, rtol=1e-8)
+    np.testing.assert_allclose(again.oat_k, first.oat_k, rtol=1e-8)
+    with pytest.raises(PitotcalError, match="virtual temperature"):
+        pitotcal.read_flight(tmp_path / "again.csv", rh_pct=50.0)

@@ -55,3 +55,10 @@ def test_inverse_and_slope():
 def test_altitude_outside_the_troposphere_is_refused():
     with pytest.raises(PitotcalError, match="pressure_altitude_m 12000 is outside the ISA"):
         tas_from_cas_mps(50.0, 12000.0)
+
+
+def test_a_negative_cas_keeps_its_sign():
+    from pitotcal.core.speeds import tas_from_cas_mps
+
+    tas = tas_from_cas_mps(np.array([10.0, -10.0]), 3000.0)
+    assert tas[0] > 10.0 and tas[1] == -tas[0]

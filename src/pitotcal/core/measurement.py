@@ -93,12 +93,13 @@ def impact_pressure_pa(rho_kgm3, tas_sq):
     return 0.5 * rho_kgm3 * tas_sq
 
 
-def _lib(x):
-    """numpy for arrays and numbers, casadi for symbols (the air-data relations take `lib`)."""
-    if isinstance(x, (np.ndarray, float, int, np.floating)):
-        return np
-    import casadi as ca
-    return ca
+def _lib(*operands):
+    """casadi when any operand is a CasADi type (MX, SX, DM), else numpy (arrays, lists and
+    numbers, which the air-data relations then check): the relations take `lib`."""
+    if any(type(x).__module__.startswith("casadi") for x in operands):
+        import casadi as ca
+        return ca
+    return np
 
 
 class IncompressibleAir(NamedTuple):
@@ -126,15 +127,18 @@ class TotalPressureAir(NamedTuple):
     oat: object
 
     def qc_pa(self, tas_sq):
-        return airdata.qc_from_total_pa(tas_sq, self.pt, self.oat, _lib(self.pt))
+        return airdata.qc_from_total_pa(tas_sq, self.pt, self.oat,
+                                        _lib(tas_sq, self.pt, self.oat))
 
     def derivatives(self, tas_sq):
-        return airdata.qc_from_total_derivatives(tas_sq, self.pt, self.oat, _lib(self.pt))
+        return airdata.qc_from_total_derivatives(tas_sq, self.pt, self.oat,
+                                                 _lib(tas_sq, self.pt, self.oat))
 
     def tas_sq(self, qc_pa):
         """The inverse at p_s = p_T − q_c; a negative q_c gives a negative V_t²."""
-        return _tas_sq_of_mach(airdata.mach_from_qc(qc_pa, self.pt - qc_pa, _lib(self.pt)),
-                               self.oat)
+        lib = _lib(qc_pa, self.pt, self.oat)
+        pt, qc = (np.asarray(v, float) for v in (self.pt, qc_pa)) if lib is np else (self.pt, qc_pa)
+        return _tas_sq_of_mach(airdata.mach_from_qc(qc, pt - qc, lib), self.oat)
 
 
 class StaticAir(NamedTuple):
@@ -144,14 +148,17 @@ class StaticAir(NamedTuple):
     oat: object
 
     def qc_pa(self, tas_sq):
-        return airdata.qc_from_tas_sq_pa(tas_sq, self.ps, self.oat, _lib(self.ps))
+        return airdata.qc_from_tas_sq_pa(tas_sq, self.ps, self.oat,
+                                         _lib(tas_sq, self.ps, self.oat))
 
     def derivatives(self, tas_sq):
-        return airdata.qc_from_tas_sq_derivatives(tas_sq, self.ps, self.oat, _lib(self.ps))
+        return airdata.qc_from_tas_sq_derivatives(tas_sq, self.ps, self.oat,
+                                                  _lib(tas_sq, self.ps, self.oat))
 
     def tas_sq(self, qc_pa):
         """The inverse; a negative q_c gives a negative V_t²."""
-        return _tas_sq_of_mach(airdata.mach_from_qc(qc_pa, self.ps, _lib(self.ps)), self.oat)
+        return _tas_sq_of_mach(airdata.mach_from_qc(qc_pa, self.ps, _lib(qc_pa, self.ps, self.oat)),
+                               self.oat)
 
 
 def _tas_sq_of_mach(mach, oat_k):

@@ -13,6 +13,7 @@ from . import airdata
 from .units import kt_to_mps, mps_to_kt
 
 __all__ = [
+    "MAX_PRESSURE_ERROR",
     "MODELS",
     "PressureErrorModel",
     "delta_v_kt",
@@ -20,7 +21,12 @@ __all__ = [
     "get_model",
     "qc_from_qci_pa",
     "qci_from_qc_pa",
+    "worst_pressure_error",
 ]
+
+# The largest pressure error |Δp/q_c| of a working pitot-static system: beyond half the impact
+# pressure lost the sensor reads next to none (a working system's is a few percent).
+MAX_PRESSURE_ERROR = 0.5
 
 
 @dataclass(frozen=True)
@@ -129,3 +135,12 @@ def delta_v_kt_where_defined(model, k, vi_kt, air_data="incompressible"):
     out = np.full(np.shape(qc), np.nan)
     out[ok] = mps_to_kt(airspeed_of(qc[ok]) - vi_mps[ok])
     return out
+
+
+def worst_pressure_error(model, k, vi_kt, air_data="incompressible"):
+    """max |f(q_ci; k)| over the indicated airspeeds `vi_kt` (q_ci by the law of `air_data`);
+    inf where f is not finite."""
+    qci = airdata.airspeed_law(air_data)[0](kt_to_mps(np.asarray(vi_kt, dtype=float)))
+    with np.errstate(all="ignore"):
+        ratio = np.abs(np.asarray(model(k, qci), dtype=float))
+    return float(np.max(np.where(np.isfinite(ratio), ratio, np.inf))) if ratio.size else 0.0

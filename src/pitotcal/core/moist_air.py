@@ -174,10 +174,18 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
         raise FlightDataError(f"{flight.source}: column rh_pct, row {bad + 1}: {rh[bad]:g} is "
                               "outside 0-100 %")
     t_air = np.asarray(oat, dtype=float)
+    if flight.meta.get(_OAT_VIRTUAL) and oat is flight.oat_k:
+        # a file pitotcal wrote after converting: its oat_k is the virtual temperature already
+        if rh_pct is not None:
+            raise PitotcalError(f"{flight.source}: its oat_k is the virtual temperature of its "
+                                "rh_pct already (# oat_k_is): a humidity cannot be applied "
+                                "again; read the original file", param="rh_pct")
+        meta[_OAT_VIRTUAL] = flight.meta[_OAT_VIRTUAL]
+        rh = None
     if rh is not None:
         # the air-data relations take the virtual temperature: the dry-air temperature of
         # the same density (ρ = p/(R T_v)) and, within 0.1 %, speed of sound (a² = γ R T_v)
         t_air = virtual_temperature_k(t_air, ps, rh)
         meta[_OAT_VIRTUAL] = "virtual temperature (rh_pct applied)"
     return dataclasses.replace(flight, oat_k=t_air, rho_kgm3=ps / (R_AIR_JKGK * t_air),
-                               rh_pct=rh, meta=meta)
+                               rh_pct=flight.rh_pct if rh is None else rh, meta=meta)

@@ -70,7 +70,9 @@ def tas_from_cas_mps(cas_mps, altitude_m):
     >>> round(float(tas_from_cas_mps(51.444, 244.0)), 2)          # 100 KCAS at 800 ft
     52.05
     """
-    return tas_from_qc_mps(qc_from_cas_pa(cas_mps), altitude_m)
+    cas_mps = np.asarray(cas_mps, dtype=float)
+    # qc_from_cas_pa squares the speed: a negative CAS keeps its sign, as the inverses do
+    return np.sign(cas_mps) * tas_from_qc_mps(qc_from_cas_pa(np.abs(cas_mps)), altitude_m)
 
 
 def qc_slope_per_tas(tas_mps, altitude_m):

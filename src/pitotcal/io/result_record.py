@@ -10,11 +10,12 @@ GPS error and the reading were part of them (`RECORD_KEYS`) are read as they are
 import math
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.models import MODELS, get_model
+from pitotcal.core.models import MAX_PRESSURE_ERROR, MODELS, get_model, worst_pressure_error
 
 from .jsonfile import read_json
 
-__all__ = ["MAX_ABS_K1", "RECORD_KEYS", "check_noise_model", "missing_record_keys", "read_result", "record_calibration"]
+__all__ = ["RECORD_KEYS", "check_noise_model", "missing_record_keys", "read_result",
+           "record_calibration"]
 
 # Keys a record holds since the monitor's noise model, the stated GPS error and the reading
 # were added to it.
@@ -95,6 +96,9 @@ def read_result(source, *, name=None, table=True):
         for key in _ROW_KEYS:
             if key == "vi_kt" or key in row:
                 _check_number(label, f"airspeed_correction[{j}].{key}", row, key)
+        _check_range(label, f"airspeed_correction[{j}].vi_kt", float("nan") if
+                     row["vi_kt"] is None else row["vi_kt"], 0.0, math.inf, "an airspeed",
+                     low_open=True)
     if doc["model"] not in MODELS:
         raise PitotcalError(f"{label}: not a pitotcal identify result JSON: key 'model' is "
                             f"{doc['model']!r}, not one of "
@@ -109,8 +113,7 @@ def read_result(source, *, name=None, table=True):
         entry = doc["parameters"].get(par)
         _check_type(label, f"parameters.{par}", entry, dict, "an object with a value")
         _check_number(label, f"parameters.{par}.value", entry, "value")
-    _check_range(label, "parameters.k1.value", doc["parameters"]["k1"]["value"], -MAX_ABS_K1,
-                 MAX_ABS_K1, "a pressure-error ratio (|k1| < 0.5)")
+    _check_pressure_error(label, doc)
     _check_range(label, "noise_std_pa", doc.get("noise_std_pa"), 0.0, math.inf,
                  "a positive noise", low_open=True)
     if doc.get("noise_model") is not None:
@@ -118,9 +121,23 @@ def read_result(source, *, name=None, table=True):
     return dict(doc)
 
 
-# The pressure-error ratio dp/q_c of any working pitot-static system is a few percent; 0.5
-# (half the impact pressure lost) is beyond any calibration a flight could support.
-MAX_ABS_K1 = 0.5
+_WHERE = {True: "at the table's speeds", False: "(k1, no table)"}
+
+
+def _check_pressure_error(label, doc):
+    """The record's pressure error |f(q_ci; k)| within MAX_PRESSURE_ERROR at the speeds of its
+    table (the rule `simulate` holds its truth to), or |k1| without a table."""
+    model = get_model(doc["model"])
+    k = [float(doc["parameters"][name]["value"]) for name in model.params]
+    vi = [row["vi_kt"] for row in doc.get("airspeed_correction", ())]
+    worst = (worst_pressure_error(model, k, vi, doc.get("air_data", "incompressible")) if vi
+             else abs(k[0]))
+    if not worst < MAX_PRESSURE_ERROR:
+        keys = ", ".join(f"'parameters.{n}.value' {v:g}" for n, v in zip(model.params, k))
+        raise PitotcalError(f"{label}: keys {keys}: not a pitot-static system's "
+                            f"calibration: |dp/qc| reaches {worst:.3g} "
+                            f"{_WHERE[bool(vi)]}, at "
+                            f"most {MAX_PRESSURE_ERROR:g}")
 # The noise model's scales (relative to q_ci; m/s): positive, finite and below these bounds
 # (a residual as large as q_ci itself, or 50 m/s of airspeed, is no calibration's noise).
 _NOISE_BOUNDS = (("block_s", 1e6), ("rel_std", 1.0), ("innovation_rel_std", 1.0),

@@ -171,3 +171,25 @@ def test_an_older_record_is_read_with_a_note():
     for short in ({**_record(), "gps_error": stated}, {**_record(), "noise_model": None}):
         cal = Calibration.from_dict(short, source="short.json")
         assert cal.noise.get("fallback") and "too short" in cal.notes[0]
+
+
+def test_a_large_k1_with_a_small_ratio_over_the_flown_speeds_is_read(tmp_path):
+    """The record's pressure error is bounded where it was flown (the rule `simulate` holds its
+    truth to), not by k1 alone: inverse k1 0.6, k2 -700 Pa keeps |dp/qc| <= 0.29 at 70-100 kt."""
+    doc = {"model": "inverse", "air_data": "incompressible", "noise_std_pa": 1.0,
+           "parameters": {"k1": {"value": 0.6}, "k2": {"value": -700.0}},
+           "airspeed_correction": [{"vi_kt": v, "dv_kt": 0.0, "dv_2sigma_kt": 0.1}
+                                   for v in (70.0, 85.0, 100.0)]}
+    assert read_result(doc)["parameters"]["k1"]["value"] == 0.6
+    doc["parameters"]["k2"]["value"] = 0.0            # then 0.6 everywhere: refused
+    with pytest.raises(PitotcalError, match=r"'parameters.k1.value' 0.6.*reaches 0.6"):
+        read_result(doc)
+
+
+@pytest.mark.parametrize("vi", [0.0, -80.0, None])
+def test_a_table_speed_that_is_no_airspeed_is_refused(vi):
+    doc = {"model": "constant", "air_data": "incompressible", "noise_std_pa": 1.0,
+           "parameters": {"k1": {"value": 0.01}},
+           "airspeed_correction": [{"vi_kt": vi, "dv_kt": 0.0, "dv_2sigma_kt": 0.1}]}
+    with pytest.raises(PitotcalError, match=r"airspeed_correction\[0\].vi_kt"):
+        read_result(doc)
