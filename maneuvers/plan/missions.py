@@ -267,7 +267,9 @@ def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl",
     ground_elevation_m : float, optional
         The ground at the centre, m above mean sea level: a loiter less than
         `MIN_CLEARANCE_M` above it is refused; without it an "msl" mission is a warning
-        (`check_ground_clearance`).
+        (`check_ground_clearance`). With "agl" the plan's altitude is above mean sea level
+        (its ISA air; `pitotcal plan` adds the ground's elevation to --altitude-m) and the
+        mission's loiter altitude is that minus the ground's elevation.
 
     Returns
     -------
@@ -281,11 +283,16 @@ def build_mission(plan, center_lat_deg, center_lon_deg, *, altitude_ref="msl",
     if ground_elevation_m is not None:
         ground_elevation_m = number("ground_elevation_m", ground_elevation_m, -500.0, 9000.0)
     bank, turn = check_loiter(plan)
-    check_ground_clearance(float(plan.settings["altitude_m"]), altitude_ref, ground_elevation_m)
     s = plan.settings
+    # the plan flies at its altitude above mean sea level (its ISA air); an "agl" mission
+    # counts from home, the ground's elevation below it
+    alt = float(s["altitude_m"])
+    if altitude_ref == "agl" and ground_elevation_m is not None:
+        alt -= ground_elevation_m
+    check_ground_clearance(alt if altitude_ref == "agl" else float(s["altitude_m"]),
+                           altitude_ref, ground_elevation_m)
     radius = float(s["radius_m"]) * (1.0 if s.get("turn", "right") == "right" else -1.0)
     frame = FRAME_GLOBAL if altitude_ref == "msl" else FRAME_GLOBAL_RELATIVE_ALT
-    alt = float(s["altitude_m"])
     cas, loiter_s, error = speed_levels(plan)
     items = []
     for v, t in zip(cas, loiter_s):

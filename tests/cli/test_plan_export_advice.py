@@ -69,4 +69,28 @@ def test_less_than_30_m_above_the_ground_is_refused(alt, ref, ground):
 
 def test_ground_elevation_without_export_is_refused(tmp_path, capsys):
     assert main(["plan", "--ground-elevation-m", "488", "-o", str(tmp_path / "p.csv")]) == 2
-    assert "--ground-elevation-m is for --export" in capsys.readouterr().err
+    assert "--ground-elevation-m is for --export or --altitude-ref agl" in capsys.readouterr().err
+
+
+def test_agl_plans_its_airspeeds_at_the_ground_plus_the_height(tmp_path, capsys):
+    """--altitude-ref agl --altitude-m 300 over ground at 1500 m flies the same air, so the same
+    true airspeeds and radius advice, as --altitude-m 1800 (MSL); its mission counts from home."""
+    import json
+
+    from pitotcal.io.plan_csv import read_plan
+
+    common = ["--center", "47", "8", "--ground-elevation-m", "1500", "--radius-m", "661",
+              "--duration-s", "308", "--export", "px4", "--no-figures"]
+    assert main(["plan", *common, "--altitude-m", "1800", "-o", str(tmp_path / "m.csv")]) == 0
+    assert main(["plan", *common, "--altitude-ref", "agl", "--altitude-m", "300",
+                 "-o", str(tmp_path / "a.csv")]) == 0
+    msl, agl = (read_plan(tmp_path / f"{n}.csv") for n in ("m", "a"))
+    assert agl.tas_mps.tolist() == msl.tas_mps.tolist()
+    items = json.loads((tmp_path / "a.plan").read_text())["mission"]["items"]
+    assert {item["params"][6] for item in items if item["command"] == 19} == {300.0}
+
+
+def test_agl_without_ground_elevation_is_a_warning(tmp_path, capsys):
+    assert main(["plan", "--center", "47", "8", "--altitude-ref", "agl", "--no-figures",
+                 "-o", str(tmp_path / "p.csv")]) == 0
+    assert "--altitude-ref agl without --ground-elevation-m" in capsys.readouterr().err

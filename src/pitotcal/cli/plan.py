@@ -146,9 +146,9 @@ def _geo_settings(args):
         from pitotcal.maneuvers.plan.export_checks import check_exportable_turn
 
         check_exportable_turn(args.turn)        # before planning: no radius advice first
-    elif args.ground_elevation_m is not None:
-        raise PitotcalError("--ground-elevation-m is for --export: the mission's loiters "
-                            "are checked against it")
+    elif args.ground_elevation_m is not None and args.altitude_ref != "agl":
+        raise PitotcalError("--ground-elevation-m is for --export or --altitude-ref agl: the "
+                            "mission's loiters are checked against it")
     if args.center is None:
         if args.export:
             raise PitotcalError(f"--export {args.export} needs --center LAT LON: the "
@@ -237,11 +237,28 @@ def _request(args, max_iter):
                                                 ("levels", args.levels)) if value is not None}
     return PlanRequest(
         cas_min_kt=args.cas_min_kt, cas_max_kt=args.cas_max_kt, radius_m=args.radius_m,
-        altitude_m=args.altitude_m, duration_s=args.duration_s, bank_max_deg=args.bank_max_deg,
+        altitude_m=_msl_altitude_m(args), duration_s=args.duration_s,
+        bank_max_deg=args.bank_max_deg,
         wind_speed_mps=args.wind_speed_mps, wind_from_deg=args.wind_from_deg,
         roll_rate_max_dps=args.roll_rate_max_dps, accel_max_mps2=args.accel_max_mps2,
         return_leg=args.return_leg, turn=args.turn, dt_s=args.dt_s, max_iter=max_iter,
         design=args.design, design_options=given or None, **schedule)
+
+
+def _msl_altitude_m(args):
+    """The altitude the plan's true airspeeds are computed at, m above mean sea level: with
+    --altitude-ref agl, --altitude-m is above home, so the ground's elevation is added (a
+    warning when it is not given: the ground is then taken at sea level)."""
+    if args.altitude_ref != "agl":
+        return args.altitude_m
+    if args.ground_elevation_m is None:
+        import warnings
+
+        warnings.warn("--altitude-ref agl without --ground-elevation-m: the plan's true "
+                      "airspeeds take the ground at mean sea level (about 2.5 % too low per "
+                      "500 m of ground elevation); give --ground-elevation-m", stacklevel=2)
+        return args.altitude_m
+    return args.altitude_m + args.ground_elevation_m
 
 
 def _check_outputs(args, paths):
