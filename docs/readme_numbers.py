@@ -5,7 +5,8 @@ Each quoted result sits between ``<!-- readme-numbers:NAME -->`` and
 output excerpt). This script runs the example behind each NAME through the command line, as a
 reader would, and writes what it printed between the markers::
 
-    python docs/readme_numbers.py             # rewrite README.md (deterministic examples)
+    python docs/readme_numbers.py             # rewrite README.md (deterministic examples) and
+                                              # copy the figures they make into docs/figures
     python docs/readme_numbers.py --check     # exit 1 naming each block that differs
     python docs/readme_numbers.py --timings   # also the wall-clock numbers (this machine)
     python docs/readme_numbers.py --tests     # also time the lean test suite (~90 s alone)
@@ -22,6 +23,7 @@ import io
 import json
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -60,6 +62,13 @@ def _cli(*args):
 
 
 # ---- deterministic examples -------------------------------------------------------------------
+
+def demo_table(tmp):
+    """`pitotcal demo` (seed 0): the calibration table it prints, as it prints it."""
+    text = _cli("demo", "--out", tmp / "demo").splitlines()
+    head = next(i for i, line in enumerate(text) if line.lstrip().startswith("V_i kt"))
+    end = next(i for i in range(head, len(text)) if not text[i].strip())
+    return "\n".join(["", "", "```", *text[head:end], "```", "", ""])
 
 def studies_cell(_):
     from pitotcal.studies import STUDY_NAMES
@@ -206,6 +215,7 @@ def tests_time(_):
 
 # name -> (kind, generator); kinds beyond "fixed" run only when asked
 GENERATORS = {
+    "demo-table": ("fixed", demo_table),
     "studies-cell": ("fixed", studies_cell),
     "studies-usage": ("fixed", studies_cell),
     "compressible-table": ("fixed", compressible_table),
@@ -218,19 +228,31 @@ GENERATORS = {
 }
 
 
+# name -> ((file its example wrote, relative to its folder), README figure); copied into docs/
+# when the README is rewritten, so the figure shows the numbers the block quotes
+FIGURES = {
+    "demo-table": (("demo/calibration.png", "docs/figures/demo-calibration.png"),
+                   ("demo/plan.png", "docs/figures/demo-plan.png")),
+}
+
+
 def blocks(text):
     """{name: body} of the marked blocks of `text` (a name may appear more than once)."""
     return {m["name"]: m["body"] for m in _BLOCK.finditer(text)}
 
 
-def generate(names):
-    """{name: fresh body} for `names` (None: the example could not run here)."""
+def generate(names, figures=False):
+    """{name: fresh body} for `names` (None: the example could not run here); with `figures`,
+    also copy each example's figures (FIGURES) into docs/figures."""
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         for name in names:
             work = Path(tmp) / name
             work.mkdir()
             out[name] = GENERATORS[name][1](work)
+            for made, dest in FIGURES.get(name, ()) if figures else ():
+                if (work / made).is_file():
+                    shutil.copyfile(work / made, ROOT / dest)
     return out
 
 
@@ -257,7 +279,7 @@ def main(argv=None):
     names = [n for n in GENERATORS if n in present and GENERATORS[n][0] in kinds]
     if args.only:
         names = [n for n in args.only.split(",") if n in present]
-    fresh = generate(names)
+    fresh = generate(names, figures=not args.check)
     for name, new in fresh.items():
         if new is None:
             print(f"{name}: left as it is (its data is absent: set PITOTCAL_SHARED_DATA)")
