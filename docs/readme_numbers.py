@@ -129,6 +129,40 @@ def _sign(x, digits=2):
     return f"{x:+.{digits}f}".replace("-", "−")
 
 
+BUDGET_SIM = ("--seed", 1, "--turbulence-mps", 0, "--air-data", "compressible",
+              "--probe-arm-m", -1, "--oat-bias-k", 1)
+
+
+def budget_example(tmp):
+    """The budget's worked example: calm T-2 flight, a wingtip probe and a warm OAT probe."""
+    from pitotcal.core.models import delta_v_kt, get_model
+
+    _cli("plan", "--no-figures", "-o", tmp / "plan.csv")
+    _cli("simulate", tmp / "plan.csv", "-o", tmp / "ex.csv", *BUDGET_SIM)
+    _cli("identify", tmp / "ex.csv", "--probe-arm-m", 1, "--json", tmp / "ex.json",
+         "--plot", tmp / "ex.png")
+    res = json.loads((tmp / "ex.json").read_text())
+    truth = json.loads((tmp / "ex.truth.json").read_text())
+    model = get_model(truth["model"])
+    k = [truth["parameters"][p] for p in model.params]
+    rows = res["airspeed_correction"]
+    pick = [rows[0], *(r for r in rows if r["vi_kt"] in (82.0, 94.0)), rows[-1]]
+    out = ["", "", "| KIAS | true ΔV | estimated ΔV | error | ±2σ | ±U |",
+           "|---:|---:|---:|---:|---:|---:|"]
+    ratios = []
+    for r in pick:
+        true = float(delta_v_kt(model, k, [r["vi_kt"]], "compressible")[0])
+        err = r["dv_kt"] - true
+        ratios.append(abs(err) / r["dv_2sigma_kt"])
+        out.append(f"| {r['vi_kt']:.1f} | {_sign(true)} | {_sign(r['dv_kt'])} | {_sign(err)} | "
+                   f"{r['dv_2sigma_kt']:.2f} | {r['dv_U_kt']:.2f} |")
+    inside = all(abs(r["dv_kt"] - float(delta_v_kt(model, k, [r["vi_kt"]], "compressible")[0]))
+                 <= r["dv_U_kt"] for r in pick)
+    out += ["", f"The error is {min(ratios):.0f}–{max(ratios):.0f}× the 2σ band and "
+                f"{'inside' if inside else 'NOT inside'} U.\n"]
+    return "\n".join(out)
+
+
 LEGS_MAKE = ("from pitotcal.maneuvers.fly.legs import simulate_leg_flight as s; \\\n"
              "  from pitotcal.io.flight_csv import write_flight_csv as w; "
              "w(s(seed=3, rate_hz=5)[0], 'legflight.csv')")
@@ -216,6 +250,7 @@ def tests_time(_):
 # name -> (kind, generator); kinds beyond "fixed" run only when asked
 GENERATORS = {
     "demo-table": ("fixed", demo_table),
+    "budget-example": ("fixed", budget_example),
     "studies-cell": ("fixed", studies_cell),
     "studies-usage": ("fixed", studies_cell),
     "compressible-table": ("fixed", compressible_table),
@@ -233,6 +268,7 @@ GENERATORS = {
 FIGURES = {
     "demo-table": (("demo/calibration.png", "docs/figures/demo-calibration.png"),
                    ("demo/plan.png", "docs/figures/demo-plan.png")),
+    "budget-example": (("ex.png", "docs/figures/budget-calibration.png"),),
 }
 
 
