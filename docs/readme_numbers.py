@@ -10,6 +10,7 @@ reader would, and writes what it printed between the markers::
     python docs/readme_numbers.py --check     # exit 1 naming each block that differs
     python docs/readme_numbers.py --timings   # also the wall-clock numbers (this machine)
     python docs/readme_numbers.py --tests     # also time the lean test suite (~90 s alone)
+    python docs/readme_numbers.py --studies   # also the studies' tables (~1 min each)
     python docs/readme_numbers.py --only legs-flight,studies-usage
 
 The real-log example reads the ArduPlane SITL log from $PITOTCAL_SHARED_DATA (else the nearest
@@ -163,6 +164,33 @@ def budget_example(tmp):
     return "\n".join(out)
 
 
+# ---- studies (seeded, deterministic, but a minute or more each: only with --studies) -----------
+
+BUDGET_TERMS = ("statistical", "oat", "humidity", "gps_velocity_bias", "gps_latency",
+                "probe_lever_arm", "qc_scale", "qc_offset")
+
+
+def budget_study(tmp):
+    """`pitotcal study budget --runs 5 --seed 0`: each term beside the statistical part."""
+    _cli("study", "budget", "--runs", 5, "--seed", 0, "--workers", 0, "--out", tmp)
+    levels = json.loads((tmp / "budget.json").read_text())["by_turbulence_mps"]
+    out = ["", "", "| turbulence | 2σ | U (k = 2) | u stat | u OAT | u humidity | u GPS bias | "
+                   "u latency | u probe arm | u gain | u offset |",
+           "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for level, row in sorted(levels.items(), key=lambda kv: float(kv[0])):
+        calm = float(level) == 0
+        two = f"{row['two_sigma_kt']:.3f}" if calm else f"{row['two_sigma_kt']:.2f}"
+        terms = " | ".join(f"{row['u_dv_kt'][t]:.3f}" for t in BUDGET_TERMS)
+        out.append(f"| {float(level):g} m/s | {two} | {row['U_kt']:.2f} | {terms} |")
+    calm = levels["0"]
+    stat = calm["u_dv_kt"]["statistical"]
+    least = min(calm["u_dv_kt"][t] for t in ("oat", "humidity", "probe_lever_arm"))
+    out += ["", f"In calm air U is {calm['U_over_2sigma']:.0f}× the statistical 2σ: the OAT, an "
+                f"unknown humidity and a 1 m probe arm\nalone are each over {int(least / stat)}× "
+                "the statistical σ.", ""]
+    return "\n".join(out)
+
+
 LEGS_MAKE = ("from pitotcal.maneuvers.fly.legs import simulate_leg_flight as s; \\\n"
              "  from pitotcal.io.flight_csv import write_flight_csv as w; "
              "w(s(seed=3, rate_hz=5)[0], 'legflight.csv')")
@@ -196,18 +224,47 @@ def legs_flight(tmp):
 
 # ---- the real log ---------------------------------------------------------------------------
 
-def sitl_ratio(tmp):
-    """`pitotcal identify arduplane_sitl.log --oat-c 15 --params`: the ratio it recommends."""
+def _sitl_log():
+    """The ArduPlane SITL log of the shared data folder (None when absent)."""
     data = shared_data()
     log = None if data is None else data / "ardupilot" / "arduplane_sitl.log"
-    if log is None or not log.is_file():
-        return None
+    return log if log is not None and log.is_file() else None
+
+
+def _sitl_params(tmp, log):
+    """(ARSPD_RATIO, its 2σ, the log's value) that `identify LOG --oat-c 15 --params` writes."""
     _cli("identify", log, "--oat-c", 15, "--no-budget", "--params", tmp / "sitl.parm")
     text = (tmp / "sitl.parm").read_text()
     value, two = map(float, re.search(r"ARSPD_RATIO = ([\d.]+) \+/- ([\d.]+)", text).groups())
-    current = float(re.search(r"current value ([\d.]+)", text).group(1))
+    return value, two, float(re.search(r"current value ([\d.]+)", text).group(1))
+
+
+def sitl_ratio(tmp):
+    """`pitotcal identify arduplane_sitl.log --oat-c 15 --params`: the ratio it recommends."""
+    log = _sitl_log()
+    if log is None:
+        return None
+    value, two, current = _sitl_params(tmp, log)
     return (f"{value:.4f} ± {two:.4f} against the simulator's {current:.4f} "
             f"({_sign(100 * (value / current - 1), 2)} %)")
+
+
+def sitl_k1(tmp):
+    """`pitotcal identify arduplane_sitl.log --oat-c 15 --model constant`, both air data, and
+    the ratio `--params` recommends from it."""
+    log = _sitl_log()
+    if log is None:
+        return None
+    k = {}
+    for air in ("compressible", "incompressible"):
+        _cli("identify", log, "--oat-c", 15, "--model", "constant", "--air", air, "--no-budget",
+             "--json", tmp / f"{air}.json")
+        k1 = json.loads((tmp / f"{air}.json").read_text())["parameters"]["k1"]
+        k[air] = (k1["value"], 2 * k1["std"])
+    ratio, two, _ = _sitl_params(tmp, log)
+    return (f"k1 = {k['compressible'][0]:.4f} ± {k['compressible'][1]:.4f} with the default "
+            f"compressible calibration ({k['incompressible'][0]:.4f} with\n  `--air "
+            f"incompressible`, ArduPilot's own convention), i.e. ratio {ratio:.3f} ± {two:.3f}")
 
 
 # ---- wall-clock numbers of this machine -------------------------------------------------------
@@ -251,12 +308,14 @@ def tests_time(_):
 GENERATORS = {
     "demo-table": ("fixed", demo_table),
     "budget-example": ("fixed", budget_example),
+    "budget-study": ("studies", budget_study),
     "studies-cell": ("fixed", studies_cell),
     "studies-usage": ("fixed", studies_cell),
     "compressible-table": ("fixed", compressible_table),
     "legs-truth": ("fixed", legs_truth),
     "legs-flight": ("fixed", legs_flight),
     "sitl-ratio": ("data", sitl_ratio),
+    "sitl-k1": ("data", sitl_k1),
     "demo-time": ("timings", demo_time),
     "identify-time": ("timings", identify_time),
     "tests-time": ("tests", tests_time),
@@ -269,6 +328,7 @@ FIGURES = {
     "demo-table": (("demo/calibration.png", "docs/figures/demo-calibration.png"),
                    ("demo/plan.png", "docs/figures/demo-plan.png")),
     "budget-example": (("ex.png", "docs/figures/budget-calibration.png"),),
+    "budget-study": (("budget.png", "docs/figures/budget.png"),),
 }
 
 
@@ -306,10 +366,12 @@ def main(argv=None):
     p.add_argument("--check", action="store_true", help="compare only; exit 1 on a difference")
     p.add_argument("--timings", action="store_true", help="also the wall-clock numbers")
     p.add_argument("--tests", action="store_true", help="also time the lean test suite")
+    p.add_argument("--studies", action="store_true",
+                   help="also the studies' tables (seeded; a minute or more each)")
     p.add_argument("--only", default=None, help="comma-separated block names")
     args = p.parse_args(argv)
     kinds = {"fixed", "data"} | ({"timings"} if args.timings else set()) \
-        | ({"tests"} if args.tests else set())
+        | ({"tests"} if args.tests else set()) | ({"studies"} if args.studies else set())
     text = README.read_text(encoding="utf-8")
     present = blocks(text)
     names = [n for n in GENERATORS if n in present and GENERATORS[n][0] in kinds]
