@@ -191,6 +191,28 @@ def budget_study(tmp):
     return "\n".join(out)
 
 
+def monitor_example(tmp):
+    """The monitor figure's flight: the monitor study's calibration, T-2 flight seed 0 in
+    0.5 m/s turbulence with a 4 kt/min icing ramp from 60 s."""
+    import warnings
+
+    from pitotcal.estimation.monitor.monitoring import monitor
+    from pitotcal.maneuvers import Fault, apply_fault
+    from pitotcal.studies.engine.common import get_flight
+    from pitotcal.studies.monitor.study import calibration
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        flight, truth = get_flight(None, {"turbulence_mps": 0.5}, 0)
+        res = monitor(apply_fault(flight, truth, Fault("icing", 60.0, 4.0, seed=0)),
+                      calibration())
+        res.plot(tmp / "monitor-example.png")
+    first = res.alarms[0]
+    return (f"flagged at {first['start_s']:.1f} s by the {first['statistic']} test, classified "
+            f"`{first['kind']}`, {_sign(first['size'])} {first['size_unit']}, the\nchange dated "
+            f"from ~{first['onset_s']:.0f} s")
+
+
 LEGS_MAKE = ("from pitotcal.maneuvers.fly.legs import simulate_leg_flight as s; \\\n"
              "  from pitotcal.io.flight_csv import write_flight_csv as w; "
              "w(s(seed=3, rate_hz=5)[0], 'legflight.csv')")
@@ -309,6 +331,7 @@ GENERATORS = {
     "demo-table": ("fixed", demo_table),
     "budget-example": ("fixed", budget_example),
     "budget-study": ("studies", budget_study),
+    "monitor-example": ("fixed", monitor_example),
     "studies-cell": ("fixed", studies_cell),
     "studies-usage": ("fixed", studies_cell),
     "compressible-table": ("fixed", compressible_table),
@@ -329,6 +352,7 @@ FIGURES = {
                    ("demo/plan.png", "docs/figures/demo-plan.png")),
     "budget-example": (("ex.png", "docs/figures/budget-calibration.png"),),
     "budget-study": (("budget.png", "docs/figures/budget.png"),),
+    "monitor-example": (("monitor-example.png", "docs/figures/monitor-example.png"),),
 }
 
 
