@@ -370,8 +370,8 @@ def generate(names, figures=False):
             work = Path(tmp) / name
             work.mkdir()
             out[name] = GENERATORS[name][1](work)
-            for made, dest in FIGURES.get(name, ()) if figures else ():
-                if (work / made).is_file():
+            for made, dest in FIGURES.get(name, ()):
+                if figures and (work / made).is_file():
                     shutil.copyfile(work / made, ROOT / dest)
     return out
 
