@@ -5,10 +5,12 @@ Each quoted result sits between ``<!-- readme-numbers:NAME -->`` and
 output excerpt). This script runs the example behind each NAME through the command line, as a
 reader would, and writes what it printed between the markers::
 
-    python docs/readme_numbers.py             # rewrite README.md (deterministic examples)
+    python docs/readme_numbers.py             # rewrite README.md (deterministic examples) and
+                                              # copy the figures they make into docs/figures
     python docs/readme_numbers.py --check     # exit 1 naming each block that differs
     python docs/readme_numbers.py --timings   # also the wall-clock numbers (this machine)
     python docs/readme_numbers.py --tests     # also time the lean test suite (~90 s alone)
+    python docs/readme_numbers.py --studies   # also the studies' tables (~1 min each)
     python docs/readme_numbers.py --only legs-flight,studies-usage
 
 The real-log example reads the ArduPlane SITL log from $PITOTCAL_SHARED_DATA (else the nearest
@@ -22,6 +24,7 @@ import io
 import json
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -60,6 +63,13 @@ def _cli(*args):
 
 
 # ---- deterministic examples -------------------------------------------------------------------
+
+def demo_table(tmp):
+    """`pitotcal demo` (seed 0): the calibration table it prints, as it prints it."""
+    text = _cli("demo", "--out", tmp / "demo").splitlines()
+    head = next(i for i, line in enumerate(text) if line.lstrip().startswith("V_i kt"))
+    end = next(i for i in range(head, len(text)) if not text[i].strip())
+    return "\n".join(["", "", "```", *text[head:end], "```", "", ""])
 
 def studies_cell(_):
     from pitotcal.studies import STUDY_NAMES
@@ -120,6 +130,89 @@ def _sign(x, digits=2):
     return f"{x:+.{digits}f}".replace("-", "−")
 
 
+BUDGET_SIM = ("--seed", 1, "--turbulence-mps", 0, "--air-data", "compressible",
+              "--probe-arm-m", -1, "--oat-bias-k", 1)
+
+
+def budget_example(tmp):
+    """The budget's worked example: calm T-2 flight, a wingtip probe and a warm OAT probe."""
+    from pitotcal.core.models import delta_v_kt, get_model
+
+    _cli("plan", "--no-figures", "-o", tmp / "plan.csv")
+    _cli("simulate", tmp / "plan.csv", "-o", tmp / "ex.csv", *BUDGET_SIM)
+    _cli("identify", tmp / "ex.csv", "--probe-arm-m", 1, "--json", tmp / "ex.json",
+         "--plot", tmp / "ex.png")
+    res = json.loads((tmp / "ex.json").read_text())
+    truth = json.loads((tmp / "ex.truth.json").read_text())
+    model = get_model(truth["model"])
+    k = [truth["parameters"][p] for p in model.params]
+    rows = res["airspeed_correction"]
+    pick = [rows[0], *(r for r in rows if r["vi_kt"] in (82.0, 94.0)), rows[-1]]
+    out = ["", "", "| KIAS | true ΔV | estimated ΔV | error | ±2σ | ±U |",
+           "|---:|---:|---:|---:|---:|---:|"]
+    ratios = []
+    for r in pick:
+        true = float(delta_v_kt(model, k, [r["vi_kt"]], "compressible")[0])
+        err = r["dv_kt"] - true
+        ratios.append(abs(err) / r["dv_2sigma_kt"])
+        out.append(f"| {r['vi_kt']:.1f} | {_sign(true)} | {_sign(r['dv_kt'])} | {_sign(err)} | "
+                   f"{r['dv_2sigma_kt']:.2f} | {r['dv_U_kt']:.2f} |")
+    inside = all(abs(r["dv_kt"] - float(delta_v_kt(model, k, [r["vi_kt"]], "compressible")[0]))
+                 <= r["dv_U_kt"] for r in pick)
+    out += ["", f"The error is {min(ratios):.0f}–{max(ratios):.0f}× the 2σ band and "
+                f"{'inside' if inside else 'NOT inside'} U.\n"]
+    return "\n".join(out)
+
+
+# ---- studies (seeded, deterministic, but a minute or more each: only with --studies) -----------
+
+BUDGET_TERMS = ("statistical", "oat", "humidity", "gps_velocity_bias", "gps_latency",
+                "probe_lever_arm", "qc_scale", "qc_offset")
+
+
+def budget_study(tmp):
+    """`pitotcal study budget --runs 5 --seed 0`: each term beside the statistical part."""
+    _cli("study", "budget", "--runs", 5, "--seed", 0, "--workers", 0, "--out", tmp)
+    levels = json.loads((tmp / "budget.json").read_text())["by_turbulence_mps"]
+    out = ["", "", "| turbulence | 2σ | U (k = 2) | u stat | u OAT | u humidity | u GPS bias | "
+                   "u latency | u probe arm | u gain | u offset |",
+           "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for level, row in sorted(levels.items(), key=lambda kv: float(kv[0])):
+        calm = float(level) == 0
+        two = f"{row['two_sigma_kt']:.3f}" if calm else f"{row['two_sigma_kt']:.2f}"
+        terms = " | ".join(f"{row['u_dv_kt'][t]:.3f}" for t in BUDGET_TERMS)
+        out.append(f"| {float(level):g} m/s | {two} | {row['U_kt']:.2f} | {terms} |")
+    calm = levels["0"]
+    stat = calm["u_dv_kt"]["statistical"]
+    least = min(calm["u_dv_kt"][t] for t in ("oat", "humidity", "probe_lever_arm"))
+    out += ["", f"In calm air U is {calm['U_over_2sigma']:.0f}× the statistical 2σ: the OAT, an "
+                f"unknown humidity and a 1 m probe arm\nalone are each over {int(least / stat)}× "
+                "the statistical σ.", ""]
+    return "\n".join(out)
+
+
+def monitor_example(tmp):
+    """The monitor figure's flight: the monitor study's calibration, T-2 flight seed 0 in
+    0.5 m/s turbulence with a 4 kt/min icing ramp from 60 s."""
+    import warnings
+
+    from pitotcal.estimation.monitor.monitoring import monitor
+    from pitotcal.maneuvers import Fault, apply_fault
+    from pitotcal.studies.engine.common import get_flight
+    from pitotcal.studies.monitor.study import calibration
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        flight, truth = get_flight(None, {"turbulence_mps": 0.5}, 0)
+        res = monitor(apply_fault(flight, truth, Fault("icing", 60.0, 4.0, seed=0)),
+                      calibration())
+        res.plot(tmp / "monitor-example.png")
+    first = res.alarms[0]
+    return (f"flagged at {first['start_s']:.1f} s by the {first['statistic']} test, classified "
+            f"`{first['kind']}`, {_sign(first['size'])} {first['size_unit']}, the\nchange dated "
+            f"from ~{first['onset_s']:.0f} s")
+
+
 LEGS_MAKE = ("from pitotcal.maneuvers.fly.legs import simulate_leg_flight as s; \\\n"
              "  from pitotcal.io.flight_csv import write_flight_csv as w; "
              "w(s(seed=3, rate_hz=5)[0], 'legflight.csv')")
@@ -153,18 +246,47 @@ def legs_flight(tmp):
 
 # ---- the real log ---------------------------------------------------------------------------
 
-def sitl_ratio(tmp):
-    """`pitotcal identify arduplane_sitl.log --oat-c 15 --params`: the ratio it recommends."""
+def _sitl_log():
+    """The ArduPlane SITL log of the shared data folder (None when absent)."""
     data = shared_data()
     log = None if data is None else data / "ardupilot" / "arduplane_sitl.log"
-    if log is None or not log.is_file():
-        return None
+    return log if log is not None and log.is_file() else None
+
+
+def _sitl_params(tmp, log):
+    """(ARSPD_RATIO, its 2σ, the log's value) that `identify LOG --oat-c 15 --params` writes."""
     _cli("identify", log, "--oat-c", 15, "--no-budget", "--params", tmp / "sitl.parm")
     text = (tmp / "sitl.parm").read_text()
     value, two = map(float, re.search(r"ARSPD_RATIO = ([\d.]+) \+/- ([\d.]+)", text).groups())
-    current = float(re.search(r"current value ([\d.]+)", text).group(1))
+    return value, two, float(re.search(r"current value ([\d.]+)", text).group(1))
+
+
+def sitl_ratio(tmp):
+    """`pitotcal identify arduplane_sitl.log --oat-c 15 --params`: the ratio it recommends."""
+    log = _sitl_log()
+    if log is None:
+        return None
+    value, two, current = _sitl_params(tmp, log)
     return (f"{value:.4f} ± {two:.4f} against the simulator's {current:.4f} "
             f"({_sign(100 * (value / current - 1), 2)} %)")
+
+
+def sitl_k1(tmp):
+    """`pitotcal identify arduplane_sitl.log --oat-c 15 --model constant`, both air data, and
+    the ratio `--params` recommends from it."""
+    log = _sitl_log()
+    if log is None:
+        return None
+    k = {}
+    for air in ("compressible", "incompressible"):
+        _cli("identify", log, "--oat-c", 15, "--model", "constant", "--air", air, "--no-budget",
+             "--json", tmp / f"{air}.json")
+        k1 = json.loads((tmp / f"{air}.json").read_text())["parameters"]["k1"]
+        k[air] = (k1["value"], 2 * k1["std"])
+    ratio, two, _ = _sitl_params(tmp, log)
+    return (f"k1 = {k['compressible'][0]:.4f} ± {k['compressible'][1]:.4f} with the default "
+            f"compressible calibration ({k['incompressible'][0]:.4f} with\n  `--air "
+            f"incompressible`, ArduPilot's own convention), i.e. ratio {ratio:.3f} ± {two:.3f}")
 
 
 # ---- wall-clock numbers of this machine -------------------------------------------------------
@@ -206,15 +328,31 @@ def tests_time(_):
 
 # name -> (kind, generator); kinds beyond "fixed" run only when asked
 GENERATORS = {
+    "demo-table": ("fixed", demo_table),
+    "budget-example": ("fixed", budget_example),
+    "budget-study": ("studies", budget_study),
+    "monitor-example": ("fixed", monitor_example),
     "studies-cell": ("fixed", studies_cell),
     "studies-usage": ("fixed", studies_cell),
     "compressible-table": ("fixed", compressible_table),
     "legs-truth": ("fixed", legs_truth),
     "legs-flight": ("fixed", legs_flight),
     "sitl-ratio": ("data", sitl_ratio),
+    "sitl-k1": ("data", sitl_k1),
     "demo-time": ("timings", demo_time),
     "identify-time": ("timings", identify_time),
     "tests-time": ("tests", tests_time),
+}
+
+
+# name -> ((file its example wrote, relative to its folder), README figure); copied into docs/
+# when the README is rewritten, so the figure shows the numbers the block quotes
+FIGURES = {
+    "demo-table": (("demo/calibration.png", "docs/figures/demo-calibration.png"),
+                   ("demo/plan.png", "docs/figures/demo-plan.png")),
+    "budget-example": (("ex.png", "docs/figures/budget-calibration.png"),),
+    "budget-study": (("budget.png", "docs/figures/budget.png"),),
+    "monitor-example": (("monitor-example.png", "docs/figures/monitor-example.png"),),
 }
 
 
@@ -223,14 +361,18 @@ def blocks(text):
     return {m["name"]: m["body"] for m in _BLOCK.finditer(text)}
 
 
-def generate(names):
-    """{name: fresh body} for `names` (None: the example could not run here)."""
+def generate(names, figures=False):
+    """{name: fresh body} for `names` (None: the example could not run here); with `figures`,
+    also copy each example's figures (FIGURES) into docs/figures."""
     out = {}
     with tempfile.TemporaryDirectory() as tmp:
         for name in names:
             work = Path(tmp) / name
             work.mkdir()
             out[name] = GENERATORS[name][1](work)
+            for made, dest in FIGURES.get(name, ()):
+                if figures and (work / made).is_file():
+                    shutil.copyfile(work / made, ROOT / dest)
     return out
 
 
@@ -248,16 +390,18 @@ def main(argv=None):
     p.add_argument("--check", action="store_true", help="compare only; exit 1 on a difference")
     p.add_argument("--timings", action="store_true", help="also the wall-clock numbers")
     p.add_argument("--tests", action="store_true", help="also time the lean test suite")
+    p.add_argument("--studies", action="store_true",
+                   help="also the studies' tables (seeded; a minute or more each)")
     p.add_argument("--only", default=None, help="comma-separated block names")
     args = p.parse_args(argv)
     kinds = {"fixed", "data"} | ({"timings"} if args.timings else set()) \
-        | ({"tests"} if args.tests else set())
+        | ({"tests"} if args.tests else set()) | ({"studies"} if args.studies else set())
     text = README.read_text(encoding="utf-8")
     present = blocks(text)
     names = [n for n in GENERATORS if n in present and GENERATORS[n][0] in kinds]
     if args.only:
         names = [n for n in args.only.split(",") if n in present]
-    fresh = generate(names)
+    fresh = generate(names, figures=not args.check)
     for name, new in fresh.items():
         if new is None:
             print(f"{name}: left as it is (its data is absent: set PITOTCAL_SHARED_DATA)")

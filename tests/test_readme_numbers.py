@@ -40,12 +40,27 @@ def test_readme_block_is_a_fresh_run(fresh, name):
         f"README.md block {name} is stale: run `python docs/readme_numbers.py`")
 
 
-def test_the_sitl_ratio_is_a_fresh_run(tmp_path):
-    got = rn.sitl_ratio(tmp_path)
+DATA = [n for n, (kind, _) in rn.GENERATORS.items() if kind == "data"]
+
+
+@pytest.mark.parametrize("name", DATA)
+def test_real_log_block_is_a_fresh_run(tmp_path, name):
+    got = rn.GENERATORS[name][1](tmp_path)
     if got is None:
         pytest.skip("the ArduPlane SITL log is absent: set PITOTCAL_SHARED_DATA to the folder "
                     "holding ardupilot/arduplane_sitl.log")
-    assert rn.blocks(README)["sitl-ratio"] == got
+    assert rn.blocks(README)[name] == got
+
+
+STUDIES = [n for n, (kind, _) in rn.GENERATORS.items() if kind == "studies"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", STUDIES)
+def test_study_block_is_a_fresh_run(tmp_path, name):
+    """The studies' tables (seeded, a minute or more each)."""
+    assert rn.blocks(README)[name] == rn.GENERATORS[name][1](tmp_path), (
+        f"README.md block {name} is stale: run `python docs/readme_numbers.py --studies`")
 
 
 def test_rewrite_replaces_only_the_bodies():

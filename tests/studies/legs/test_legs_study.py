@@ -2,6 +2,7 @@
 
 import json
 import re
+import warnings
 
 import pytest
 from pitotcal.studies.catalog import STUDIES, rerun, run_study
@@ -44,7 +45,10 @@ LEGS_FLIGHT_HEADLINE = (r"legs detected as flown in \S+% of runs \(\S+% of the l
 
 
 def test_legs_flight_study_lean(tmp_path):
-    summary = run_study("legs-flight", runs=2, out_dir=tmp_path, workers=0, quick=True, seed=5)
+    with warnings.catch_warnings():       # one line per run on stderr was 100 lines per study
+        warnings.simplefilter("error")
+        summary = run_study("legs-flight", runs=2, out_dir=tmp_path, workers=0, quick=True,
+                            seed=5)
     rows = read_table(tmp_path / "legs-flight.csv")
     assert len(rows) == summary["n_rows"] == 2 * 4 and summary["n_failed"] == 0
     assert {"dv_true_kt", "point_half_kt", "global_half_kt", "series_half_kt",
