@@ -144,15 +144,17 @@ def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct
 
     qci = data[:, col["qc_pa"]]
     vn, ve = data[:, col["gps_vn_mps"]], data[:, col["gps_ve_mps"]]
+    alt = data[:, col["alt_m"]] if "alt_m" in col else None
     if "ps_pa" in col and "oat_k" in col:
-        check_ps_oat(name, data[:, col["ps_pa"]], data[:, col["oat_k"]])
+        check_ps_oat(name, data[:, col["ps_pa"]], data[:, col["oat_k"]], alt=alt,
+                     rho=data[:, col["rho_kgm3"]] if "rho_kgm3" in col else None)
     if "rho_kgm3" in col:
         rho = data[:, col["rho_kgm3"]]
         check_rho(name, rho)
     else:
         temperature = data[:, col["oat_k" if "oat_k" in col else "tat_k"]]
         if "oat_k" not in col:              # total temperature: with_static_air converts it
-            check_ps_oat(name, data[:, col["ps_pa"]], temperature)
+            check_ps_oat(name, data[:, col["ps_pa"]], temperature, alt=alt)
         rho = density_kgm3(data[:, col["ps_pa"]], temperature)
     check_units(name, qci, vn, ve, rho)
     # no implausible cell left, the units of time and of the vertical speed
@@ -162,7 +164,8 @@ def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct
         check_vertical_speed(name, data[:, col["gps_vd_mps"]], vn, ve, time_s,
                              data[:, col["alt_m"]] if "alt_m" in col else None)
     if "ps_ref_pa" in col:
-        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, ISA_T0_K), column="ps_ref_pa")
+        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, ISA_T0_K), column="ps_ref_pa",
+                     alt=alt)
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
                 for c in (*OPTIONAL_COLUMNS, *STATIC_COLUMNS, *TEMPERATURE_COLUMNS)}
     flight = Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
