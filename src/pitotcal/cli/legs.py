@@ -97,8 +97,10 @@ def run(args):
 
     choice("model", args.model, list(MODELS))
     choice("wind", args.wind, WIND_CHOICES)
+    from pitotcal.io.read_once import is_stream
+
     source = Path(args.legs)
-    if not source.is_file():
+    if not source.is_file() and not is_stream(source):
         raise PitotcalError(f"{source}: no such file", param="legs")
     flight = _is_flight(source)
     check_outputs({"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out},
