@@ -102,6 +102,19 @@ def test_the_cli_says_it_in_one_line_and_exits_2(demo_columns, tmp_path, capsys,
     assert not (tmp_path / "r.json").exists()
 
 
+def test_minutes_at_10_hz_are_told_by_the_climb(demo_columns, tmp_path):
+    """Above 1 ms a step in minutes is a plausible step in seconds; a climb of 1 m/s then
+    makes the altitude change 60 m per metre of integrated vertical speed."""
+    cols = {k: v[::5].copy() for k, v in demo_columns.items()}          # 10 Hz
+    cols["gps_vd_mps"] = np.full(cols["time_s"].size, -1.0)
+    cols["alt_m"] = 300.0 + (cols["time_s"] - cols["time_s"][0])
+    read_flight(_write(dict(cols), tmp_path / "seconds.csv"))           # in seconds: fine
+    cols["time_s"] = cols["time_s"] / 60.0
+    with pytest.raises(FlightDataError, match=r"column time_s looks like minutes \(the altitude "
+                                              r"changes 60 m per metre"):
+        read_flight(_write(cols, tmp_path / "flight.csv"))
+
+
 def test_static_pressure_without_a_density_column_names_every_unit_that_fits(demo_columns,
                                                                               tmp_path):
     cols = _converted(demo_columns, "ps_pa", "psi")

@@ -368,13 +368,18 @@ def check_vertical_speed(name, vd, vn, ve, t=None, alt=None):
     """Refuse `gps_vd_mps` in cm/s (or in another unit, or not a vertical speed).
 
     Two tests: its median magnitude against the ground speed, and, with `alt_m`, the
-    altitude change against the integrated vertical speed (1 in m/s, 0.01 in cm/s).
+    altitude change against the integrated vertical speed (1 in m/s, 0.01 in cm/s; 60 is a
+    time column in minutes, named as such).
     """
     gs = float(np.median(np.hypot(vn, ve)))
     vd_med = float(np.median(np.abs(vd)))
     slope = _altitude_slope(vd, t, alt)
     if vd_med <= _VD_RATIO_MAX * gs and (slope is None or 0.3 <= slope <= 3.0):
         return
+    if slope is not None and 30.0 <= slope <= 120.0:       # 60: the clock, not the speed
+        raise FlightDataError(f"{name}: column time_s looks like minutes (the altitude changes "
+                              f"{slope:.3g} m per metre of the integrated gps_vd_mps; 60 in "
+                              "minutes); expected seconds (time_s = value x 60)")
     if slope is not None and 0.003 <= slope <= 0.03 or \
             slope is None and vd_med / 100.0 <= _VD_RATIO_MAX * gs:
         how = (f"the altitude changes {slope:.3g} m per unit of its integral"
