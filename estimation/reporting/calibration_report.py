@@ -12,7 +12,6 @@ import base64
 import datetime
 import hashlib
 import math
-import tomllib
 import warnings
 from pathlib import Path
 
@@ -22,23 +21,12 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.io.atomic import atomic_open, atomic_path
 
 from . import compliance as comp
+from .aircraft_file import AIRCRAFT_FIELDS, read_aircraft
 from .budget_tables import budget_report
 from .conditions import turbulence_text
 
 __all__ = ["AIRCRAFT_FIELDS", "build_report", "make_report", "read_aircraft", "read_result",
            "render_html", "sha256", "write_pdf"]
-
-# The title block: (TOML table, key, label), in the order shown.
-AIRCRAFT_FIELDS = (
-    ("aircraft", "type", "Aircraft"), ("aircraft", "registration", "Registration"),
-    ("aircraft", "serial", "Serial number"), ("aircraft", "configuration", "Configuration"),
-    ("aircraft", "weight", "Weight"), ("aircraft", "cg", "Centre of gravity"),
-    ("aircraft", "pitot_static", "Pitot-static installation"),
-    ("test", "date", "Test date"), ("test", "location", "Location"),
-    ("test", "pilot", "Pilot"), ("test", "engineer", "Flight-test engineer"),
-    ("test", "notes", "Notes"),
-)
-
 
 def sha256(path):
     """SHA-256 hex digest of a file."""
@@ -47,37 +35,6 @@ def sha256(path):
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
-
-
-def read_aircraft(path):
-    """The title-block rows [(label, text)] of an aircraft TOML (`AIRCRAFT_FIELDS`, then any
-    other key of its tables); PitotcalError naming the file and line when it is not TOML."""
-    try:
-        with open(path, "rb") as f:
-            doc = tomllib.load(f)
-    except tomllib.TOMLDecodeError as exc:
-        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML ({exc})") from None
-    except UnicodeDecodeError:
-        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML (binary content, not "
-                            "UTF-8 text)") from None
-    except RecursionError:
-        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML (nested too deeply)") \
-            from None
-    except OSError as exc:
-        raise PitotcalError(f"`aircraft_path` {path}: cannot read it ({exc.strerror})") \
-            from None
-    rows, seen = [], set()
-    for table, key, label in AIRCRAFT_FIELDS:
-        value = doc.get(table, {}).get(key) if isinstance(doc.get(table), dict) else None
-        if value is not None:
-            rows.append((label, str(value)))
-            seen.add((table, key))
-    for table, content in doc.items():
-        items = content.items() if isinstance(content, dict) else [(None, content)]
-        for key, value in items:
-            if (table, key) not in seen:
-                rows.append((f"{table}.{key}" if key else table, str(value)))
-    return rows
 
 
 def _png(data):

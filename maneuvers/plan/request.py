@@ -14,12 +14,17 @@ from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import PROFILES
 from pitotcal.core.scenario import T2_PLAN
-from pitotcal.core.units import kt_to_mps
+from pitotcal.core.airdata import A0_MPS
+from pitotcal.core.units import KT_TO_MPS, kt_to_mps
 
 __all__ = ["DESIGNS", "MAX_DURATION_S", "MAX_ITER", "MAX_NODES", "PlanRequest", "check_node_count",
            "min_dt_s", "plan_request", "working_request"]
 
 log = logging.getLogger(__name__)
+
+CAS_MAX_KT = A0_MPS / KT_TO_MPS      # 661.5 kt: the CAS of Mach 1
+# A calibration circle is flown in a few minutes: 20 km is a 50-min orbit at 100 kt
+MAX_RADIUS_M = 20000.0
 
 # IPOPT's time grows a little faster than the node count (measured: 240 nodes 0.2 s, 1,200 6 s,
 # 2,400 19 s, 24,000 more than 5 min); beyond this a plan is refused with the dt_s that works.
@@ -147,12 +152,14 @@ class PlanRequest:
 
 def _checked_fields(r):
     """{field: checked value} of `PlanRequest` `r` (PitotcalError naming the field)."""
-    cas_min_kt, cas_max_kt = positive("cas_min_kt", r.cas_min_kt), positive("cas_max_kt",
-                                                                             r.cas_max_kt)
+    # the planner's air data are subsonic: CAS below a0 (Mach 1 at sea level, 661 kt)
+    cas_min_kt, cas_max_kt = (number(name, value, 0.0, CAS_MAX_KT, lo_open=True, hi_open=True)
+                              for name, value in (("cas_min_kt", r.cas_min_kt),
+                                                  ("cas_max_kt", r.cas_max_kt)))
     if cas_min_kt >= cas_max_kt:
         raise PlanInfeasibleError(f"cas_min_kt {cas_min_kt:g} must be below the top of the "
                                   f"airspeed range, {cas_max_kt:g} KCAS", param="cas_min_kt")
-    radius_m = positive("radius_m", r.radius_m)
+    radius_m = number("radius_m", r.radius_m, 0.0, MAX_RADIUS_M, lo_open=True)
     duration_s = positive("duration_s", r.duration_s)
     if duration_s > MAX_DURATION_S:
         raise PitotcalError(f"duration_s {exact(duration_s)} must be <= {MAX_DURATION_S:g} s: "

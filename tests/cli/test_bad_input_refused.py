@@ -114,7 +114,8 @@ def test_legs_smooth_s_1e9_is_capped_by_the_record(flown, capsys):
     import resource
 
     before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    _refused(["legs", flown[0], "--smooth-s", "1e9"], capsys, "no steady segment")
+    _refused(["legs", flown[0], "--smooth-s", "1e9"], capsys,
+             "--smooth-s 1e+09 s is longer than the flight")
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 500_000   # kB
 
 

@@ -41,12 +41,18 @@ def oat_k_from_c(oat_c):
     return oat_c + 273.15
 
 
+MAX_IDLE_S = 86400.0
+
+
 def idle_timeout_s(idle_s):
     """--idle-s checked, or the stream reader's own idle timeout when not given."""
-    from pitotcal.core.checks import positive
+    from pitotcal.core.checks import number
     from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
 
-    return IDLE_TIMEOUT_S if idle_s is None else positive("idle_s", idle_s)
+    if idle_s is None:
+        return IDLE_TIMEOUT_S
+    # a day without a message is a stream that has ended; beyond it the socket timeout overflows
+    return number("idle_s", idle_s, 0.0, MAX_IDLE_S, lo_open=True)
 
 
 def announce_stream(command, connection, idle_s):

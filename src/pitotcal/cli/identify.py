@@ -136,6 +136,14 @@ def _help_constants():
             "idle_s": IDLE_TIMEOUT_S}
 
 
+# What a stated uncertainty or lever arm can be: beyond these it is no measurement (a
+# thermometer 50 K off, a GPS velocity 5 m/s off, a clock 2 s off, a zero offset of 1 kPa, the
+# q_c of 80 kt) and the budget would be all of it, or overflow.
+BUDGET_INPUT_RANGES = {"u_oat_k": (0.0, 50.0), "u_gps_velocity_mps": (0.0, 5.0),
+                       "u_gps_latency_s": (0.0, 2.0), "u_qc_offset_pa": (0.0, 1000.0),
+                       "probe_arm_m": (-50.0, 50.0)}
+
+
 def _budget_inputs(args):
     from pitotcal.core.checks import number
     from pitotcal.estimation.identification.budget import inputs_from_options
@@ -144,6 +152,9 @@ def _budget_inputs(args):
              else number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0) / 100.0)
     if args.u_rh_percent is not None:
         number("u_rh_percent", args.u_rh_percent, 0.0, 100.0)
+    for name, (lo, hi) in BUDGET_INPUT_RANGES.items():
+        if getattr(args, name) is not None:
+            number(name, getattr(args, name), lo, hi)
     return inputs_from_options(
         u_oat_k=args.u_oat_k, u_rh_pct=args.u_rh_percent,
         u_gps_velocity_mps=args.u_gps_velocity_mps, u_gps_latency_s=args.u_gps_latency_s,

@@ -9,6 +9,7 @@ Exit status: 0 success (a global fit the legs cannot determine is a warning, `"g
 determine TAS and wind (fewer than three legs, or ground velocities on one line).
 """
 
+import math
 from pathlib import Path
 
 WIND_CHOICES = ("per-band", "per-point")
@@ -70,6 +71,10 @@ def _help_constants():
     return {**DETECT_DEFAULTS, "point_tol_kt": POINT_TOL_KT, "band_ft": BAND_FT}
 
 
+# A track band wider than a half turn, or a speed band of 50 kt, holds every sample: no leg.
+DETECT_MAX = {"track_tol_deg": 180.0, "groundspeed_tol_kt": 50.0, "ias_tol_kt": 50.0}
+
+
 def _is_flight(path):
     from pitotcal.io.flight_csv import csv_kind
 
@@ -97,8 +102,10 @@ def run(args):
 
     choice("model", args.model, list(MODELS))
     choice("wind", args.wind, WIND_CHOICES)
+    from pitotcal.io.read_once import is_stream
+
     source = Path(args.legs)
-    if not source.is_file():
+    if not source.is_file() and not is_stream(source):
         raise PitotcalError(f"{source}: no such file", param="legs")
     flight = _is_flight(source)
     check_outputs({"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out},
@@ -152,6 +159,7 @@ def _windows(text):
 def _run_flight(args, source):
     from .common import oat_k_from_c
     from pitotcal.core.checks import number
+    from pitotcal.core.errors import PitotcalError
     from pitotcal.estimation.legs.flight import analyze_leg_flight
     from pitotcal.estimation.legs.report import (
         flight_legs_json,
@@ -163,12 +171,18 @@ def _run_flight(args, source):
     from pitotcal.io.jsonfile import write_json
     from pitotcal.io.legs_csv import write_legs
 
-    detect = {k: number(k, v, 0.0, lo_open=True) for k, v in _series_options(args).items()}
+    detect = {k: number(k, v, 0.0, DETECT_MAX.get(k, math.inf), lo_open=True)
+              for k, v in _series_options(args).items()}
     tol = 3.0 if args.point_tol_kt is None else number("--point-tol-kt", args.point_tol_kt,
                                                         0.0, 50.0, lo_open=True)
     windows = _windows(args.windows)
     flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
                          oat_k=oat_k_from_c(args.oat_c))
+    span_s = float(flight.time_s[-1] - flight.time_s[0])
+    for key in ("min_leg_s", "smooth_s"):          # a window longer than the data holds nothing
+        if detect.get(key, 0.0) > span_s:
+            raise PitotcalError(f"{key} {detect[key]:g} s is longer than the flight "
+                                f"({span_s:.0f} s of {source})", param=key)
     res = analyze_leg_flight(flight, windows, model=args.model, wind=args.wind,
                              point_tol_kt=tol, **detect)
     wrote = []          # files first, then the summary: a reader that goes away early

@@ -49,6 +49,9 @@ def add_parser(subparsers):
 
 # the test-design flags; a flag not given leaves MonitorOptions' own default
 _DESIGN_FLAGS = ("false_alarms_per_hour", "warmup_s", "drift_kt_per_min")
+# Beyond these the test design means nothing: a false alarm a minute is all the alarms there
+# are, and 60 kt a minute is a failure, not a drift. (The warm-up is bounded by the flight.)
+DESIGN_MAX = {"false_alarms_per_hour": 60.0, "drift_kt_per_min": 60.0}
 
 
 def _help_constants():
@@ -87,6 +90,7 @@ def run(args):
     import warnings
 
     from .common import announce_stream, check_outputs, idle_timeout_s, oat_k_from_c
+    from pitotcal.core.checks import number
     from pitotcal.estimation.live import monitor_stream
     from pitotcal.estimation.monitor.monitoring import monitor
     from pitotcal.estimation.monitor.cusum import MonitorOptions
@@ -102,6 +106,8 @@ def run(args):
     cal = _read_calibration(args.calibration)
     opts = MonitorOptions(**{name: getattr(args, name) for name in _DESIGN_FLAGS
                              if getattr(args, name) is not None}).checked()
+    for name, hi in DESIGN_MAX.items():
+        number(name, getattr(opts, name), hi=hi)
     idle_s = idle_timeout_s(args.idle_s)        # checked for a file too: NaN is no option
     if is_connection(args.source):
         oat_k = oat_k_from_c(args.oat_c)

@@ -49,7 +49,9 @@ def add_parser(subparsers):
 def run(args):
     from .common import check_outputs, oat_k_from_c
     from pitotcal.core.checks import choice, number
+    from pitotcal.core.errors import PitotcalError
     from pitotcal.estimation.reporting.calibration_report import make_report
+    from pitotcal.io.flight_checks import check_window
 
     choice("regulation", args.regulation, REGULATION_CHOICES)
     source = Path(args.result)
@@ -58,6 +60,13 @@ def run(args):
                   [(source, "the input result JSON"), (args.flight, "the input flight"),
                    (args.aircraft, "the input aircraft file")])
     options = {k: v for k, v in vars(args).items() if k not in ("run", "command")}
+    check_window(args.start_s, args.end_s)
+    if args.flight is None:
+        given = [f for f, v in (("--start-s", args.start_s), ("--end-s", args.end_s),
+                                ("--oat-c", args.oat_c)) if v is not None]
+        if given:
+            raise PitotcalError(f"{given[0]}: only with --flight (it says how to read the "
+                                "flight the fit is re-run on)")
     if args.temp_recovery is not None:
         number("temp_recovery", args.temp_recovery, 0.0, 1.0)
     if args.rh_percent is not None:

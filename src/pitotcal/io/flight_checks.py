@@ -12,6 +12,7 @@ import numpy as np
 from pitotcal.core import checks
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
+from pitotcal.core.units import R_AIR_JKGK, isa_altitude_m, isa_pressure_pa, isa_temperature_k
 
 __all__ = ["MAX_BAD_FRACTION", "PLAUSIBLE", "QCI_MIN_FLYING_PA", "check_plausible", "check_time_units",
            "check_units", "check_vertical_speed", "check_window", "drop_bad_rows", "looks_utf16"]
@@ -38,10 +39,19 @@ PLAUSIBLE = {"qc_pa": (0.0, 2e5), "gps_vn_mps": (-515.0, 515.0),
 # 0.35-4 covers winds up to ~70 % of the airspeed while knots (0.26) and every pressure unit
 # fall outside.
 _RATIO_OK = (0.35, 4.0)
+# (unit, Pa per unit) and (unit, m/s per unit): what a logger or a hand conversion writes
 _PRESSURE_UNITS = (("Pa", 1.0), ("hPa (mbar)", 100.0), ("kPa", 1000.0), ("psi", 6894.757),
-                   ("inH2O", 249.089))
+                   ("inH2O", 249.089), ("mmH2O", 9.80665), ("inHg", 3386.389))
+# static pressure: the same, plus mmHg (a barometer's unit; as an impact pressure it is
+# within the wind's factor of hPa, so it is not guessed for q_ci)
+_STATIC_UNITS = (*_PRESSURE_UNITS[1:], ("mmHg", 133.3224))
 _SPEED_UNITS = (("m/s", 1.0), ("knots", 1852.0 / 3600.0), ("km/h (or ft/s)", 1.0 / 3.6),
-                ("cm/s", 0.01))
+                ("mph", 0.44704), ("cm/s", 0.01))
+_WRONG_UNIT_COST = 0.2
+# named only as the one wrong column: paired with a wrong speed unit they would explain
+# almost any factor (speeds x 6 fit mmH2O with knots within 3 %)
+_ALONE_ONLY = ("mmH2O", "inHg")
+_PS_RANGE_PA = (5e3, 1.2e5)          # a static pressure of flight: 0 to 20 km, any weather
 
 
 def check_window(start_s=None, end_s=None):
@@ -199,18 +209,61 @@ def check_rho(name, rho):
                           f"kg/m^3 (0.15-1.6){unit}")
 
 
-def check_ps_oat(name, ps, oat, column="ps_pa"):
-    """Static pressure in Pa (not hPa, kPa, psi, inHg) and temperature in K (not degC)."""
+def check_ps_oat(name, ps, oat, column="ps_pa", *, rho=None, alt=None):
+    """Static pressure in Pa (not hPa, kPa, psi, inHg, mmHg) and temperature in K (not degC,
+    degF).
+
+    kPa, psi and inHg overlap in value (14 is psi at sea level or kPa at 14 km), so a pressure
+    in another unit is named by the unit whose value in Pa is nearest to a reference: rho R T
+    of a `rho_kgm3` column (`rho`), else the ISA pressure at the median `alt` (m), else sea
+    level (then every unit that fits is named).
+    """
     med = float(np.median(ps))
-    if not 5e3 <= med <= 1.2e5:
-        unit = next((u for u, lo, hi in (("hPa (mbar)", 150, 1200), ("kPa", 5, 120),
-                                         ("psi", 0.7, 17), ("inHg", 1.5, 35.4)) if lo <= med <= hi),
-                    None)
-        looks = f"looks like {unit}" if unit else "is not a static pressure"
-        raise FlightDataError(f"{name}: column {column}: median {med:.5g} {looks}; expected Pa "
-                              "(about 101325 at sea level)")
-    med = float(np.median(oat))
+    if not _PS_RANGE_PA[0] <= med <= _PS_RANGE_PA[1]:
+        raise FlightDataError(f"{name}: column {column}: median {med:.5g} "
+                              f"{_static_unit_text(med, oat, rho, alt)}; expected Pa (about "
+                              "101325 at sea level)")
+    _check_oat(name, float(np.median(oat)), med)
+
+
+def _static_unit_text(med, oat, rho, alt):
+    """'looks like psi (x 6894.757 to Pa; ...)' or 'is not a static pressure'."""
+    fits = [(u, f) for u, f in _STATIC_UNITS if _PS_RANGE_PA[0] <= med * f <= _PS_RANGE_PA[1]]
+    if not fits:
+        return "is not a static pressure"
+    ref, against = _reference_ps(oat, rho, alt)
+    fits.sort(key=lambda uf: abs(np.log(med * uf[1] / ref)))
+    unit, factor = fits[0]
+    text = f"looks like {unit} (x {factor:g} to Pa"
+    if against:
+        return text + f"; {med * factor:.0f} Pa against {ref:.0f} Pa from {against})"
+    others = ", ".join(f"{u} (x {f:g})" for u, f in fits[1:])
+    return text + (f"; or {others}" if others else "") + ")"
+
+
+def _reference_ps(oat, rho, alt):
+    """(pressure, Pa, what it comes from) to tell the units apart; ('', sea level) if none."""
+    t_med = float(np.median(oat)) if oat is not None else np.nan
+    if rho is not None and 150.0 <= t_med <= 400.0:
+        r = float(np.median(rho))
+        if 0.15 <= r <= 1.6:
+            return r * R_AIR_JKGK * t_med, "rho_kgm3 R oat_k"
+    if alt is not None and np.isfinite(alt).any():
+        h = float(np.nanmedian(alt))
+        if -500.0 <= h <= 20000.0:
+            return float(isa_pressure_pa(h)), f"the ISA at alt_m {h:.0f} m"
+    return float(isa_pressure_pa(0.0)), ""
+
+
+def _check_oat(name, med, ps_pa):
+    """The outside air temperature in K: degC and degF are named (the one nearer the ISA
+    temperature at the static pressure `ps_pa`)."""
     if med < 150:
+        t_isa = float(isa_temperature_k(isa_altitude_m(ps_pa)))
+        as_c, as_f = med + 273.15, (med - 32.0) / 1.8 + 273.15
+        if abs(as_f - t_isa) < abs(as_c - t_isa) and 180.0 <= as_f <= 330.0:
+            raise FlightDataError(f"{name}: column oat_k: median {med:.4g} looks like degrees "
+                                  "Fahrenheit; expected kelvin (K = (degF - 32) / 1.8 + 273.15)")
         raise FlightDataError(f"{name}: column oat_k: median {med:.4g} looks like degrees Celsius; "
                               "expected kelvin (K = degC + 273.15)")
     if med > 400:
@@ -237,19 +290,24 @@ def check_units(name, qci, vn, ve, rho):
                 f"{gs_med:.3g} m/s: the aircraft is not flying; select the flight with "
                 "start_s/end_s")
         return
-    # the unit pair that makes q_ci and the GPS dynamic pressure agree best
+    # the unit pair that makes q_ci and the GPS dynamic pressure agree best; one wrong column
+    # is likelier than two (inHg alone fits as well as inH2O with km/h), so each wrong unit
+    # costs a factor 1.22
     best = min(((abs(np.log(ratio * a / b ** 2)) if np.isfinite(ratio) else np.inf, pu, su)
-                for pu, a in _PRESSURE_UNITS for su, b in _SPEED_UNITS),
-               key=lambda x: x[0])
+                for pu, a in _PRESSURE_UNITS for su, b in _SPEED_UNITS
+                if su == "m/s" or pu not in _ALONE_ONLY),
+               key=lambda x: x[0] + _WRONG_UNIT_COST * ((x[1] != "Pa") + (x[2] != "m/s")))
     misfit, p_unit, s_unit = best
     implied = np.sqrt(2.0 * q_med / float(np.median(rho)))
     if misfit < np.log(2.0) and (p_unit, s_unit) != ("Pa", "m/s"):
         parts = []
         if p_unit != "Pa":
-            parts.append(f"column qc_pa: median {q_med:.4g} looks like {p_unit}, expected Pa")
+            parts.append(f"column qc_pa: median {q_med:.4g} looks like {p_unit} (x "
+                         f"{dict(_PRESSURE_UNITS)[p_unit]:g} to Pa), expected Pa")
         if s_unit != "m/s":
             parts.append(f"columns gps_vn_mps/gps_ve_mps: median ground speed {gs_med:.4g} looks "
-                         f"like {s_unit}, expected m/s")
+                         f"like {s_unit} (x {dict(_SPEED_UNITS)[s_unit]:.4g} to m/s), expected "
+                         "m/s")
         raise FlightDataError(f"{name}: {'; '.join(parts)} (q_ci / (0.5 rho Vg^2) = "
                               f"{ratio:.3g}, should be near 1)")
     raise FlightDataError(
@@ -259,14 +317,16 @@ def check_units(name, qci, vn, ve, rho):
 
 
 # The time column's unit. A calibration flight is sampled at 0.5-1000 Hz: a median
-# step above 2 "s" is a log in milliseconds or microseconds; a first time after 1e8 s (1973)
-# is a clock (Unix time), not seconds since the log started.
+# step above 2 "s" is a log in milliseconds or microseconds, one below 1 ms is a log in
+# minutes (50 Hz in minutes is a step of 0.00033); a first time after 1e8 s (1973) is a clock
+# (Unix time), not seconds since the log started.
 _TIME_STEP_MAX_S = 2.0
+_TIME_STEP_MIN_S = 1e-3
 _UNIX_TIME_MIN_S = 1e8
 
 
 def check_time_units(name, t):
-    """Refuse a time column in ms or µs (naming the unit and the rate it implies); return a
+    """Refuse a time column in ms, µs or minutes (naming the unit and the rate it implies); return a
     warning text for Unix time in seconds (used as it is: only time differences matter), or
     None."""
     step = float(np.median(np.diff(t)))
@@ -280,6 +340,14 @@ def check_time_units(name, t):
                     f"{scale:g})")
         raise FlightDataError(f"{name}: column time_s: median step {step:.6g} s between samples; "
                               f"a flight is sampled at least every {_TIME_STEP_MAX_S:g} s")
+    if step < _TIME_STEP_MIN_S:
+        if 60.0 * step >= _TIME_STEP_MIN_S:
+            raise FlightDataError(
+                f"{name}: column time_s: median step {step:.3g} looks like minutes "
+                f"({1.0 / (60.0 * step):.3g} Hz); expected seconds (time_s = value x 60)")
+        raise FlightDataError(f"{name}: column time_s: median step {step:.3g} s between samples "
+                              f"({1.0 / step:.3g} Hz); a flight is sampled at most at "
+                              f"{1.0 / _TIME_STEP_MIN_S:g} Hz")
     if t[0] >= _UNIX_TIME_MIN_S:
         import datetime
 
@@ -300,13 +368,18 @@ def check_vertical_speed(name, vd, vn, ve, t=None, alt=None):
     """Refuse `gps_vd_mps` in cm/s (or in another unit, or not a vertical speed).
 
     Two tests: its median magnitude against the ground speed, and, with `alt_m`, the
-    altitude change against the integrated vertical speed (1 in m/s, 0.01 in cm/s).
+    altitude change against the integrated vertical speed (1 in m/s, 0.01 in cm/s; 60 is a
+    time column in minutes, named as such).
     """
     gs = float(np.median(np.hypot(vn, ve)))
     vd_med = float(np.median(np.abs(vd)))
     slope = _altitude_slope(vd, t, alt)
     if vd_med <= _VD_RATIO_MAX * gs and (slope is None or 0.3 <= slope <= 3.0):
         return
+    if slope is not None and 30.0 <= slope <= 120.0:       # 60: the clock, not the speed
+        raise FlightDataError(f"{name}: column time_s looks like minutes (the altitude changes "
+                              f"{slope:.3g} m per metre of the integrated gps_vd_mps; 60 in "
+                              "minutes); expected seconds (time_s = value x 60)")
     if slope is not None and 0.003 <= slope <= 0.03 or \
             slope is None and vd_med / 100.0 <= _VD_RATIO_MAX * gs:
         how = (f"the altitude changes {slope:.3g} m per unit of its integral"

@@ -47,6 +47,7 @@ takes a slower per-column Python pass to find and name them.
 """
 
 import difflib
+import io
 import re
 import warnings
 
@@ -59,6 +60,7 @@ from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import ISA_T0_K, density_kgm3
 
 from .atomic import atomic_open
+from .read_once import open_binary, read_once
 from .flight_checks import (
     check_plausible,
     check_ps_oat,
@@ -125,6 +127,7 @@ def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct
         warning; `source` is `path` as given.
     """
     (start_s, end_s), air = check_window(start_s, end_s), check_air_options(temp_recovery, rh_pct)
+    path = read_once(path)          # "-", a FIFO or a pipe: read whole once, parsed from memory
     name = str(path)
     _reject_binary(path, name)
     header_line, columns, meta = _read_header(path, name)
@@ -144,15 +147,17 @@ def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct
 
     qci = data[:, col["qc_pa"]]
     vn, ve = data[:, col["gps_vn_mps"]], data[:, col["gps_ve_mps"]]
+    alt = data[:, col["alt_m"]] if "alt_m" in col else None
     if "ps_pa" in col and "oat_k" in col:
-        check_ps_oat(name, data[:, col["ps_pa"]], data[:, col["oat_k"]])
+        check_ps_oat(name, data[:, col["ps_pa"]], data[:, col["oat_k"]], alt=alt,
+                     rho=data[:, col["rho_kgm3"]] if "rho_kgm3" in col else None)
     if "rho_kgm3" in col:
         rho = data[:, col["rho_kgm3"]]
         check_rho(name, rho)
     else:
         temperature = data[:, col["oat_k" if "oat_k" in col else "tat_k"]]
         if "oat_k" not in col:              # total temperature: with_static_air converts it
-            check_ps_oat(name, data[:, col["ps_pa"]], temperature)
+            check_ps_oat(name, data[:, col["ps_pa"]], temperature, alt=alt)
         rho = density_kgm3(data[:, col["ps_pa"]], temperature)
     check_units(name, qci, vn, ve, rho)
     # no implausible cell left, the units of time and of the vertical speed
@@ -162,7 +167,8 @@ def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct
         check_vertical_speed(name, data[:, col["gps_vd_mps"]], vn, ve, time_s,
                              data[:, col["alt_m"]] if "alt_m" in col else None)
     if "ps_ref_pa" in col:
-        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, ISA_T0_K), column="ps_ref_pa")
+        check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, ISA_T0_K), column="ps_ref_pa",
+                     alt=alt)
     optional = {c: (np.ascontiguousarray(data[:, col[c]]) if c in col else None)
                 for c in (*OPTIONAL_COLUMNS, *STATIC_COLUMNS, *TEMPERATURE_COLUMNS)}
     flight = Flight(time_s=np.ascontiguousarray(time_s), qci_pa=np.ascontiguousarray(qci),
@@ -178,6 +184,7 @@ def csv_kind(path):
 
     Looks only at the header (after any ``#`` lines); never raises for a file it can open.
     """
+    path = read_once(path)
     name = str(path)
     try:
         _reject_binary(path, name)
@@ -209,7 +216,7 @@ class _Table:
 
 
 def _reject_binary(path, name):
-    with open(path, "rb") as f:            # read-only: the input is never modified
+    with open_binary(path) as f:
         head = f.read(65536)
     if not head.strip():
         raise FlightDataError(f"{name}: empty file, not a flight CSV")
@@ -227,7 +234,8 @@ def _reject_binary(path, name):
 def _text(path):
     # utf-8-sig drops a BOM; undecodable bytes become U+FFFD and then fail as non-numeric
     # cells or unknown column names, with a row to point at, rather than a decode error.
-    return open(path, "r", encoding="utf-8-sig", errors="replace", newline=None)
+    return io.TextIOWrapper(open_binary(path), encoding="utf-8-sig", errors="replace",
+                            newline=None)
 
 
 def _read_header(path, name):

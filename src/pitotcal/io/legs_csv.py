@@ -22,6 +22,7 @@ cell is a typo to fix. The file is opened read-only.
 """
 
 import csv
+import io
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +31,7 @@ from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
 from .atomic import atomic_open
+from .read_once import open_binary, read_once
 
 __all__ = ["LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
@@ -129,6 +131,7 @@ def read_legs(path):
         Unusable file, missing column, bad cell or implausible unit; one line naming file,
         column and row.
     """
+    path = read_once(path)          # "-", a FIFO or a pipe: read whole once
     name = str(path)
     header, rows, lines = _read_rows(path, name)
     cols = _choose_columns(header, name)
@@ -180,7 +183,7 @@ def _not_text(path):
     """Why a file that is no UTF-8 is not read: UTF-16 named as such, else binary."""
     from .flight_checks import looks_utf16
 
-    with open(path, "rb") as f:
+    with open_binary(path) as f:
         head = f.read(4096)
     return ("UTF-16 text (save it as UTF-8: a CSV here is UTF-8 or ASCII)" if looks_utf16(head)
             else "not a text CSV (binary data)")
@@ -188,7 +191,7 @@ def _not_text(path):
 
 def _read_rows(path, name):
     """(header, data rows, file line of each row); comment and blank lines skipped."""
-    with open(path, newline="", encoding="utf-8-sig") as f:
+    with io.TextIOWrapper(open_binary(path), newline="", encoding="utf-8-sig") as f:
         try:
             text = f.read()
         except UnicodeDecodeError:

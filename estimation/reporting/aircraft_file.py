@@ -1,0 +1,130 @@
+"""The report's aircraft TOML (`report --aircraft`): read, check and turn into title-block rows.
+
+The title block shows `AIRCRAFT_FIELDS` in order, then any other key of the file's tables (a
+fuel state, a flap setting: the file is the operator's own record). What is refused, in one
+line naming the key: a file that is not TOML; a key that is a misspelling of a known one
+(``registraton``, ``[aircaft]``: it would show under a wrong label and leave the field "not
+stated"); a known field that is not text, a number or a date; NaN or infinite numbers
+anywhere; a negative or zero weight; a negative speed (a key whose name says it is one).
+"""
+
+import datetime
+import difflib
+import math
+import tomllib
+
+from pitotcal.core.errors import PitotcalError
+
+__all__ = ["AIRCRAFT_FIELDS", "read_aircraft"]
+
+# The title block: (TOML table, key, label), in the order shown.
+AIRCRAFT_FIELDS = (
+    ("aircraft", "type", "Aircraft"), ("aircraft", "registration", "Registration"),
+    ("aircraft", "serial", "Serial number"), ("aircraft", "configuration", "Configuration"),
+    ("aircraft", "weight", "Weight"), ("aircraft", "cg", "Centre of gravity"),
+    ("aircraft", "pitot_static", "Pitot-static installation"),
+    ("test", "date", "Test date"), ("test", "location", "Location"),
+    ("test", "pilot", "Pilot"), ("test", "engineer", "Flight-test engineer"),
+    ("test", "notes", "Notes"),
+)
+_TABLES = tuple(dict.fromkeys(table for table, _, _ in AIRCRAFT_FIELDS))
+_KEYS = {table: [k for t, k, _ in AIRCRAFT_FIELDS if t == table] for table in _TABLES}
+# what a title-block field may hold: text, a number (weight 1050, cg 0.42) or a TOML date
+_FIELD_TYPES = (str, int, float, datetime.date, datetime.time)
+# a key whose name ends so is a speed: never negative
+_SPEED_SUFFIXES = ("_kt", "_kts", "_kias", "_kcas", "_ktas", "_mps", "_kmh", "_kph", "_mph")
+_MISSPELT = 0.8         # difflib ratio from which an unknown name is a misspelt known one
+
+
+def read_aircraft(path):
+    """The title-block rows [(label, text)] of an aircraft TOML (module docstring).
+
+    Raises
+    ------
+    PitotcalError
+        Not TOML, or a refused key or value; the message names the file and the key.
+    """
+    doc = _load(path)
+    _check(doc, path)
+    rows, seen = [], set()
+    for table, key, label in AIRCRAFT_FIELDS:
+        value = doc.get(table, {}).get(key) if isinstance(doc.get(table), dict) else None
+        if value is not None:
+            rows.append((label, str(value)))
+            seen.add((table, key))
+    for table, content in doc.items():
+        items = content.items() if isinstance(content, dict) else [(None, content)]
+        for key, value in items:
+            if (table, key) not in seen:
+                rows.append((f"{table}.{key}" if key else table, str(value)))
+    return rows
+
+
+def _load(path):
+    try:
+        with open(path, "rb") as f:
+            return tomllib.load(f)
+    except tomllib.TOMLDecodeError as exc:
+        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML ({exc})") from None
+    except UnicodeDecodeError:
+        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML (binary content, not "
+                            "UTF-8 text)") from None
+    except RecursionError:
+        raise PitotcalError(f"`aircraft_path` {path}: not valid TOML (nested too deeply)") \
+            from None
+    except OSError as exc:
+        raise PitotcalError(f"`aircraft_path` {path}: cannot read it ({exc.strerror})") \
+            from None
+
+
+def _check(doc, path):
+    """Refuse misspelt names, wrongly typed fields and bad numbers (module docstring)."""
+    def refuse(key, problem):
+        raise PitotcalError(f"`aircraft_path` {path}: key {key}: {problem}")
+
+    for table, content in doc.items():
+        if not isinstance(content, dict):
+            home = next((t for t, keys in _KEYS.items() if _near(table, keys)), None)
+            if home:
+                refuse(table, f"outside a table; put it under [{home}]")
+        elif table not in _TABLES and _near(table, _TABLES):
+            refuse(table, f"unknown table; did you mean [{_near(table, _TABLES)}]?")
+        if not isinstance(content, dict):
+            _check_value(table, content, refuse)
+            continue
+        known = _KEYS.get(table, [])
+        for key, value in content.items():
+            name = f"{table}.{key}"
+            if key not in known and _near(key, known):
+                refuse(name, f"unknown; did you mean {table}.{_near(key, known)}?")
+            if key in known and (not isinstance(value, _FIELD_TYPES) or isinstance(value, bool)):
+                refuse(name, f"{_type_name(value)}, expected text, a number or a date")
+            _check_value(name, value, refuse)
+            if name == "aircraft.weight" and isinstance(value, (int, float)) and value <= 0:
+                refuse(name, f"{value:g} is not a weight (must be positive)")
+
+
+def _check_value(name, value, refuse):
+    """Numbers finite (recursively), speeds not negative."""
+    if isinstance(value, dict):
+        for key, inner in value.items():
+            _check_value(f"{name}.{key}", inner, refuse)
+    elif isinstance(value, list):
+        for k, inner in enumerate(value):
+            _check_value(f"{name}[{k}]", inner, refuse)
+    elif isinstance(value, float) and not math.isfinite(value):
+        refuse(name, f"{value} is not a finite number")
+    elif isinstance(value, (int, float)) and not isinstance(value, bool) and value < 0 \
+            and (name.lower().endswith(_SPEED_SUFFIXES) or "speed" in name.lower()):
+        refuse(name, f"{value:g} is a negative speed")
+
+
+def _near(name, candidates):
+    close = difflib.get_close_matches(str(name).lower(), candidates, n=1, cutoff=_MISSPELT)
+    return close[0] if close else None
+
+
+def _type_name(value):
+    kinds = {dict: "a table", list: "an array", bool: "true/false"}
+    return next((text for kind, text in kinds.items() if isinstance(value, kind)),
+                type(value).__name__)

@@ -1,0 +1,63 @@
+"""The report's aircraft TOML: each bad file refused in one line naming the key (exit 2), the
+good ones shown as before."""
+
+import json
+
+import pytest
+from reportfixtures import result_json
+
+from pitotcal.cli import main
+from pitotcal.core.errors import PitotcalError
+from pitotcal.estimation.reporting.aircraft_file import read_aircraft
+
+BAD = [
+    ('[aircraft]\nregistraton = "D-EABC"\n', "key aircraft.registraton: unknown; did you mean "
+                                             "aircraft.registration?"),
+    ('[aircaft]\ntype = "DR400"\n', "key aircaft: unknown table; did you mean [aircraft]?"),
+    ('[test]\npilott = "P"\n', "key test.pilott: unknown; did you mean test.pilot?"),
+    ('registration = "D-EABC"\n', "key registration: outside a table; put it under [aircraft]"),
+    ('[aircraft]\ntype = ["DR400"]\n', "key aircraft.type: an array, expected text, a number"),
+    ('[aircraft]\nweight = true\n', "key aircraft.weight: true/false, expected text"),
+    ('[aircraft]\nconfiguration = {flaps = 10}\n', "key aircraft.configuration: a table"),
+    ("[aircraft]\nweight = nan\n", "key aircraft.weight: nan is not a finite number"),
+    ("[aircraft]\nweight = -inf\n", "key aircraft.weight: -inf is not a finite number"),
+    ("[aircraft]\nweight = -1050\n", "key aircraft.weight: -1050 is not a weight"),
+    ("[aircraft]\nweight = 0\n", "key aircraft.weight: 0 is not a weight"),
+    ("[test]\nvne_kt = -163\n", "key test.vne_kt: -163 is a negative speed"),
+    ("[test]\nwind_speed = -5.0\n", "key test.wind_speed: -5 is a negative speed"),
+    ("[test]\nspeeds_kias = [60, -70]\n", "key test.speeds_kias[1]: -70 is a negative speed"),
+    ("[test.wind]\nspeed_kt = nan\n", "key test.wind.speed_kt: nan is not a finite number"),
+    ("[aircraft]\ncg = inf\n", "key aircraft.cg: inf is not a finite number"),
+]
+
+
+@pytest.mark.parametrize("text, words", BAD, ids=[w.split(":")[0] for _, w in BAD])
+def test_a_bad_aircraft_file_is_refused_naming_the_key(tmp_path, text, words):
+    path = tmp_path / "a.toml"
+    path.write_text(text)
+    with pytest.raises(PitotcalError, match=r"`aircraft_path` .*a\.toml: ") as err:
+        read_aircraft(path)
+    assert words in str(err.value)
+
+
+@pytest.mark.parametrize("text, words", BAD[::4], ids=[w.split(":")[0] for _, w in BAD[::4]])
+def test_report_says_it_in_one_line_with_the_flag(tmp_path, capsys, text, words):
+    res, toml = tmp_path / "r.json", tmp_path / "a.toml"
+    res.write_text(json.dumps(result_json()))
+    toml.write_text(text)
+    code = main(["report", str(res), "-o", str(tmp_path / "r.html"), "--aircraft", str(toml)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith(f"pitotcal report: --aircraft {toml}: {words}"), err
+    assert not (tmp_path / "r.html").exists() and toml.read_text() == text
+
+
+def test_good_files_are_shown_whole(tmp_path):
+    path = tmp_path / "a.toml"
+    path.write_text('[aircraft]\ntype = "DR400"\nweight = 1050\ncg = -0.02\n'
+                    '[test]\ndate = 2026-05-04\nfuel = "full"\nvne_kt = 163\nballast = true\n'
+                    'pilot_notes = "calm"\n')
+    rows = read_aircraft(path)
+    assert rows == [("Aircraft", "DR400"), ("Weight", "1050"), ("Centre of gravity", "-0.02"),
+                    ("Test date", "2026-05-04"), ("test.fuel", "full"), ("test.vne_kt", "163"),
+                    ("test.ballast", "True"), ("test.pilot_notes", "calm")]
