@@ -27,11 +27,15 @@ from pitotcal.core.models import delta_v_kt, delta_v_kt_where_defined, get_model
 from ..uncertainty.covariance import colored_covariance
 from ..uncertainty.residual_noise import block_means
 
-__all__ = ["ALPHA", "HIDDEN_RATIO", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
-           "hidden_warning", "step_test"]
+__all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "KINDS", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
+           "collapse_onset_s", "hidden_warning", "step_test"]
 
-# Onsets scanned, as fractions of the record: at least a fifth of it on each side.
-ONSETS = np.linspace(0.2, 0.8, 13)
+# Onsets scanned, as fractions of the record: the whole record, 4 % of it on each side at
+# least (a blockage in the last minute of a four-minute flight is a late onset).
+ONSETS = np.linspace(0.04, 0.96, 24)
+# The alternatives tested at each onset: a step of q_ci's scale, and a ramp (q_ci falling or
+# rising steadily from the onset on, as a draining blockage or icing does).
+KINDS = ("step", "ramp")
 # The false-flag rate aimed at on a consistent flight.
 ALPHA = 0.01
 # The detection probability at which the smallest detected step is stated.
@@ -41,6 +45,10 @@ POWER = 0.95
 # detected at (threshold + z_POWER) sigma_s = 5.0 sigma_s and leaves the fit halfway, at about
 # 2.5 bands; a one-way sweep hides it at 4-6 (docs/measured.md).
 HIDDEN_RATIO = 3.0
+# A flagged fall of q_ci at least this large by the end of the record, from an onset in its
+# second half, is a collapse (a blocked pitot draining, ice closing the inlet): q_ci 20 % low
+# is V_i 11 % low, far beyond any calibration, and the record's tail is removed.
+COLLAPSE_FRACTION = 0.2
 # ... and by more than this, kt: below what an airspeed indicator shows.
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
@@ -97,25 +105,51 @@ def step_test(flight, result, air_data):
     # each onset at the first sample from its fraction of the record on (never inside a gap)
     onsets = t[np.searchsorted(t, t[0] + ONSETS * (t[-1] - t[0]))]
     first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
-    threshold = float(normal_isf(ALPHA / (2.0 * ONSETS.size)))
-    scan = _scan(jac, r, ch.qci, first, threshold)
+    threshold = float(normal_isf(ALPHA / (2.0 * len(KINDS) * ONSETS.size)))
+    scan = _scan(jac, r, _regressors(ch.qci, t, first), threshold)
     z = scan["beta"] / scan["sigma"]
     best = scan["best"]
-    details = {"onset_s": float(onsets[best]), "step": float(-scan["beta"][best]),
+    kind, at = KINDS[best // ONSETS.size], best % ONSETS.size
+    details = {"onset_s": float(onsets[at]), "kind": kind, "step": float(-scan["beta"][best]),
                "z": float(z[best]), "threshold": threshold, "alpha": ALPHA,
                "flagged": bool(abs(z[best]) > threshold)}
     hidden = _undetected(result, model, onsets, scan, threshold + float(normal_isf(1 - POWER)))
     details.update(undetected=hidden, hidden=bool(
         hidden["dv_shift_kt"] > max(HIDDEN_RATIO * hidden["dv_2sigma_kt"], MIN_SHIFT_KT)))
     if details["flagged"]:
-        beta = scan["beta"][best]
-        side = "low" if beta < 0 else "high"
-        return (f"{flight.source}: the calibration changes during the flight: from about "
-                f"t = {onsets[best]:.0f} s to the end ({t[-1]:.0f} s) q_ci reads "
-                f"{100 * abs(beta):.1f}% {side} against before (z = {z[best]:+.1f}, beyond "
-                f"{threshold:.1f}): a leak, icing, blockage or drift? One calibration for the "
-                "whole record does not hold, and its bounds are not honest"), details
+        return _change_warning(flight.source, details, t[-1]), details
     return None, details
+
+
+def _change_warning(source, details, end_s):
+    """The warning of a flagged change (`step_test`'s details)."""
+    beta = -details["step"]
+    side = "low" if beta < 0 else "high"
+    if details["kind"] == "ramp":
+        how = (f"from about t = {details['onset_s']:.0f} s on q_ci drifts steadily "
+               f"{'down' if beta < 0 else 'up'}, {100 * abs(beta):.1f}% {side} by the end "
+               f"({end_s:.0f} s)")
+        cause = "gradual blockage, icing or a drift?"
+    else:
+        how = (f"from about t = {details['onset_s']:.0f} s to the end ({end_s:.0f} s) q_ci "
+               f"reads {100 * abs(beta):.1f}% {side} against before")
+        cause = "a leak, icing, blockage or drift?"
+    return (f"{source}: the calibration changes during the flight: {how} "
+            f"(z = {details['z']:+.1f}, beyond {details['threshold']:.1f}): {cause} One "
+            "calibration for the whole record does not hold, and its bounds are not honest")
+
+
+def collapse_onset_s(details, time_s):
+    """Where a collapsed tail of q_ci starts (`step_test`'s details of the record `time_s`),
+    or None: a flagged fall of at least `COLLAPSE_FRACTION` from an onset in the second half
+    of the record. The cut is one onset of the scan earlier than the flagged one: the scan
+    places an onset only to its grid, and the samples lost before it were healthy."""
+    if not details.get("flagged") or details["step"] < COLLAPSE_FRACTION:
+        return None
+    t0, t1 = float(time_s[0]), float(time_s[-1])
+    if details["onset_s"] < t0 + 0.5 * (t1 - t0):
+        return None
+    return details["onset_s"] - (ONSETS[1] - ONSETS[0]) * (t1 - t0)
 
 
 def hidden_warning(source, details):
@@ -145,31 +179,41 @@ def _first_order(hidden):
             "subsonic range)")
 
 
-def _scan(jac, r, qci, first, threshold):
-    """The augmented fit [S, g_k] of every onset k (g_k = q_ci 1[i >= first_k], the first
-    over the whole record): step coefficients, their sigmas, and the parameter shift per unit
-    step of the plain fit that absorbs g_k (and of a change of scale over the whole record,
-    `shift_all`).
+def _regressors(qci, t, first):
+    """The alternatives' columns: a change of scale over the whole record (index 0), a step
+    g_k = q_ci 1[i >= first_k] and a ramp q_ci (t - t_k)+ / (t_end - t_k) at each onset k (the
+    ramp: a gradual blockage or icing, q_ci falling from t_k on; scaled so its coefficient is
+    the fraction changed by the end of the record)."""
+    n = qci.size
+    idx = np.arange(n)
+    steps = [np.where(idx >= k, qci, 0.0) for k in first]
+    span = max(float(t[-1] - t[0]), 1e-12)
+    ramps = [qci * np.clip(t - t[k], 0.0, None) / max(float(t[-1] - t[k]), 1e-3 * span)
+             for k in first[1:]]
+    return np.column_stack(steps + ramps)
 
-    The steps' Gram entries are tail sums (g_k . g_l = sum of q_ci^2 from max(first_k, first_l)
-    on), so no step column is formed. The white-noise sigmas come first: a step is a
-    low-frequency regressor, so under the positively correlated residuals of flight its
-    colored sigma is larger, and where no white-noise |z| exceeds the threshold no colored one
-    does. The noise-model fit, the test's main cost, is spent only on the onset of the largest
-    white-noise |z| when it is over the threshold: fitted to the residuals of the augmented
-    fit there (on the plain fit's residuals a real step would count as noise and hide itself),
-    the white-noise variance a floor.
+
+def _scan(jac, r, g, threshold):
+    """The augmented fit [S, g_k] of every alternative column g_k of `g` (`_regressors`, the
+    first a change of scale over the whole record): their coefficients, sigmas, and the
+    parameter shift per unit coefficient of the plain fit that absorbs g_k.
+
+    The white-noise sigmas come first: a step or a ramp is a low-frequency regressor, so
+    under the positively correlated residuals of flight its colored sigma is larger, and
+    where no white-noise |z| exceeds the threshold no colored one does. The noise-model fit,
+    the test's main cost, is spent only on the alternative of the largest white-noise |z|
+    when it is over the threshold: fitted to the residuals of the augmented fit there (on
+    the plain fit's residuals a real step would count as noise and hide itself), the
+    white-noise variance a floor.
     """
     n, p = jac.shape
-    m = first.size
-    q2, jq, rq = (_tail(qci * qci)[first], _tail(jac * qci[:, None])[first],
-                  _tail(r * qci)[first])
+    m = g.shape[1]
     gram = np.empty((p + m, p + m))
     gram[:p, :p] = jac.T @ jac
-    gram[:p, p:] = jq.T
-    gram[p:, :p] = jq
-    gram[p:, p:] = q2[np.maximum.outer(np.arange(m), np.arange(m))]
-    xr, rr = np.r_[jac.T @ r, rq], float(r @ r)
+    gram[:p, p:] = jac.T @ g
+    gram[p:, :p] = gram[:p, p:].T
+    gram[p:, p:] = g.T @ g
+    xr, rr = np.r_[jac.T @ r, g.T @ r], float(r @ r)
     cols = [np.r_[np.arange(p), p + k] for k in range(m)]
     inv_k = [np.linalg.inv(gram[np.ix_(idx, idx)]) for idx in cols]
     coef = [mk @ xr[idx] for mk, idx in zip(inv_k, cols)]
@@ -180,7 +224,7 @@ def _scan(jac, r, qci, first, threshold):
     plain = sigma.copy()
     best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
     if abs(beta[best]) > threshold * sigma[best]:
-        x = np.column_stack([jac, np.where(np.arange(n) >= first[best], qci, 0.0)])
+        x = np.column_stack([jac, g[:, best]])
         # on block means of `b` samples: the regressors are smooth over a block (the step is
         # one jump in ~N / b blocks) and the noise model is fitted to what the blocks keep, at
         # a cost independent of N
@@ -195,11 +239,6 @@ def _scan(jac, r, qci, first, threshold):
     return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:],
             "shift": shift[1:],
             "shift_all": shift[0], "cov_plain": float(np.mean(s2[1:])) * m_inv}
-
-
-def _tail(x):
-    """Sums from each row to the end (along the first axis)."""
-    return np.cumsum(x[::-1], axis=0)[::-1]
 
 
 def _dv_shift_kt(model, k_shifted, vi_kt, dv_fit_kt, first_order_kt, air_data):
