@@ -142,7 +142,14 @@ def _fit_trimmed(flight, fit, air_data, check=True):
         else ((), {})
     cut = consistency.collapse_onset_s(found, kept.time_s) if found else None
     if cut is not None:
-        result, step_note, found = _without_collapse(kept, fit, air_data, cut, found)
+        try:
+            result, step_note, found = _without_collapse(kept, fit, air_data, cut, found)
+        except PitotcalError as exc:    # what is left cannot be fitted: the whole, named
+            step_note = (f"{flight.source}: q_ci collapses at the end of the record (from "
+                         f"about t = {found['onset_s']:.0f} s, z = {found['z']:+.1f}): a "
+                         "blocked pitot or icing? The calibration below is fitted on the "
+                         "whole record because the samples before it cannot be fitted alone "
+                         f"({exc}); do not use it",) + tuple(step_note)
     result = dataclasses.replace(result, consistency=found)
     if keep.all():
         return result, step_note
@@ -159,8 +166,9 @@ def _without_collapse(flight, fit, air_data, cut_s, found):
     consistency checks repeated on what is kept."""
     head = flight.select(flight.time_s < cut_s)
     result = _with_static_fit(fit(head))
+    left = max(100.0 * (1.0 - found["step"]), 0.0)    # a ramp's line may reach below zero
     note = (f"{flight.source}: q_ci collapses at the end of the record: from about "
-            f"t = {found['onset_s']:.0f} s it falls to {100 * (1 - found['step']):.0f}% of "
+            f"t = {found['onset_s']:.0f} s it falls to {left:.0f}% of "
             f"what one calibration predicts by the end ({flight.time_s[-1]:.0f} s; z = "
             f"{found['z']:+.1f}): a blocked pitot or icing? The samples from t = {cut_s:.0f} s "
             f"on ({int(flight.n - head.n)}) are removed and the calibration is fitted on "
