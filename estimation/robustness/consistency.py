@@ -34,10 +34,12 @@ from ..uncertainty.residual_noise import block_means
 __all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "KINDS", "MARGIN", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
            "collapse_onset_s", "hidden_warning", "step_test"]
 
-# Onsets scanned, as fractions of the record: the whole record, 2 % of it on each side at
-# least (a blockage in the last minute of a four-minute flight is a late onset), every 3 %
-# (finer costs threshold: the Bonferroni bound grows with the number of alternatives).
-ONSETS = np.linspace(0.02, 0.98, 33)
+# Onsets scanned, as fractions of the record, every 3 % (finer costs threshold: the Bonferroni
+# bound grows with the number of alternatives): from a fifth of the record, as a change before
+# it leaves too few samples to be told from the start's own transients (in 3 m/s turbulence a
+# step from 2 % of the record flags every clean simulated flight), to its last 2 % (a
+# blockage in the last minute of a four-minute flight is the late fault to catch).
+ONSETS = np.linspace(0.2, 0.98, 27)
 # The alternatives tested at each onset: a step of q_ci's scale, and a ramp (q_ci falling or
 # rising steadily from the onset on, as a draining blockage or icing does).
 KINDS = ("step", "ramp")
@@ -59,6 +61,12 @@ HIDDEN_RATIO = 3.0
 # second half, is a collapse (a blocked pitot draining, ice closing the inlet): q_ci 20 % low
 # is V_i 11 % low, far beyond any calibration, and the record's tail is removed.
 COLLAPSE_FRACTION = 0.2
+# ... and so is a record whose q_ci ends, over its last `COLLAPSE_WINDOW_S`, below this
+# fraction of the impact pressure the GPS and the fitted wind give (against its median over
+# the record), whatever the scan's z: V_i 29 % low, a gust of 10 m/s held for seconds at 70 kt,
+# four sigma of 3 m/s turbulence; a draining blockage reaches it in a drain time or so.
+COLLAPSE_RATIO = 0.5
+COLLAPSE_WINDOW_S = 5.0
 # ... and by more than this, kt: below what an airspeed indicator shows.
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
@@ -80,7 +88,30 @@ def check(flight, result, air_data):
     step_note, details = step_test(flight, result, air_data)
     jump_note, details["jump"] = jump_test(flight)
     hidden = None if jump_note else hidden_warning(flight.source, details)
+    ratio = _smoothed_ratio(flight, result, air_data)
+    healthy = np.flatnonzero(ratio >= 0.95)
+    details.update(end_ratio=float(ratio[-1]), healthy_until_s=float(
+        flight.time_s[healthy[-1]] if healthy.size else flight.time_s[0]))
     return tuple(w for w in (step_note, jump_note, hidden) if w), details
+
+
+def _smoothed_ratio(flight, result, air_data):
+    """(the smoothed ratio of q_ci to the impact pressure of GPS and fitted wind, against its
+    median over the record, at each sample: a running median over `COLLAPSE_WINDOW_S`)."""
+    from scipy.ndimage import median_filter
+
+    from pitotcal.core.measurement import as_air, tas_squared
+
+    ch = flight_channels(flight, result.gps_noise_std_mps, air_data)
+    wind_n, wind_e = result.internal_params[-2], result.internal_params[-1]
+    qc = as_air(ch.air).qc_pa(tas_squared(ch.vn, ch.ve, wind_n, wind_e, ch.vd2))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.asarray(ch.qci, float) / np.asarray(qc, float)
+    ratio = np.where(np.isfinite(ratio), ratio, 1.0)
+    dt = float(np.median(np.diff(flight.time_s))) if flight.n > 1 else 1.0
+    width = max(1, int(round(COLLAPSE_WINDOW_S / max(dt, 1e-9))))
+    smooth = median_filter(ratio, size=width, mode="nearest")
+    return smooth / max(float(np.median(ratio)), 1e-12)
 
 
 def step_test(flight, result, air_data):
@@ -152,16 +183,24 @@ def _change_warning(source, details, end_s):
 
 
 def collapse_onset_s(details, time_s):
-    """Where a collapsed tail of q_ci starts (`step_test`'s details of the record `time_s`),
-    or None: a flagged fall of at least `COLLAPSE_FRACTION` from an onset in the second half
-    of the record. The cut is one onset of the scan earlier than the flagged one: the scan
-    places an onset only to its grid, and the samples lost before it were healthy."""
-    if not details.get("flagged") or details["step"] < COLLAPSE_FRACTION:
-        return None
+    """Where a collapsed tail of q_ci starts (`check`'s details of the record `time_s`), or
+    None.
+
+    A collapse: a flagged fall of at least `COLLAPSE_FRACTION` from an onset in the second
+    half of the record, or a record whose smoothed q_ci ends below `COLLAPSE_RATIO` of what
+    the GPS gives (``end_ratio``), from where it last stood at 0.95 of it (``healthy_until_s``). The cut is one
+    onset of the scan earlier: the scan places an onset only to its grid, and the samples
+    lost before it were healthy."""
     t0, t1 = float(time_s[0]), float(time_s[-1])
-    if details["onset_s"] < t0 + 0.5 * (t1 - t0):
+    onsets = []
+    if details.get("flagged") and details["step"] >= COLLAPSE_FRACTION \
+            and details["onset_s"] >= t0 + 0.5 * (t1 - t0):
+        onsets.append(details["onset_s"])
+    if details.get("end_ratio", 1.0) < COLLAPSE_RATIO:
+        onsets.append(details["healthy_until_s"])
+    if not onsets:
         return None
-    return details["onset_s"] - (ONSETS[1] - ONSETS[0]) * (t1 - t0)
+    return min(onsets) - (ONSETS[1] - ONSETS[0]) * (t1 - t0)
 
 
 def hidden_warning(source, details):

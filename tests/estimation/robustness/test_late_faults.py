@@ -95,6 +95,7 @@ def test_late_faults_campaign(kind):
 
 @pytest.mark.slow
 def test_clean_flights_change_warning_rate():
-    """200 clean return-sweep flights: the change warning near its design rate ALPHA."""
-    named = [bool(outcome(None, seed)[1]["named"]) for seed in range(200)]
+    """200 clean return-sweep flights (seeds apart from the 200 `MARGIN` was measured on):
+    the change warning near its design rate ALPHA = 1 % (6 of 200 is beyond it at p < 0.5 %)."""
+    named = [bool(outcome(None, seed)[1]["named"]) for seed in range(200, 400)]
     assert sum(named) <= 6, sum(named)
