@@ -48,7 +48,7 @@ ALPHA = 0.01
 # Standard deviations added to the Gaussian Bonferroni bound: the step's colored sigma comes
 # from a one-exponential noise model fitted to a record only some 10-20 turbulence correlation
 # times long, so z has heavier tails than the normal (200 clean return-sweep flights in
-# 0.5 m/s turbulence: 8 beyond the bound 3.79, 4 %; 2 beyond 4.29, 1 %: docs/measured.md).
+# 0.5 m/s turbulence: 7 beyond the bound 3.74, 3.5 %; 2 beyond 4.24, 1 %: docs/measured.md).
 MARGIN = 0.5
 # The detection probability at which the smallest detected step is stated.
 POWER = 0.95
