@@ -43,6 +43,10 @@ ONSETS = np.linspace(0.2, 0.98, 27)
 # The alternatives tested at each onset: a step of q_ci's scale, and a ramp (q_ci falling or
 # rising steadily from the onset on, as a draining blockage or icing does).
 KINDS = ("step", "ramp")
+# The onsets whose missed step is stated (`hidden_warning`): up to 80 % of the record. A change
+# later than that leaves one calibration for most of the record; its smallest detected size,
+# from a few samples, is large and says nothing about the maneuver.
+HIDDEN_LAST_ONSET = 0.8
 # The false-flag rate aimed at on a consistent flight.
 ALPHA = 0.01
 # Standard deviations added to the Gaussian Bonferroni bound: the step's colored sigma comes
@@ -156,7 +160,8 @@ def step_test(flight, result, air_data):
                "z": float(z[best]), "threshold": threshold, "alpha": ALPHA,
                "flagged": bool(abs(z[best]) > threshold)}
     # the maneuver's geometry: the Gaussian bound (the margin is for the noise model's tails)
-    hidden = _undetected(result, model, onsets, scan, bound + float(normal_isf(1 - POWER)))
+    mid = onsets[:int(np.sum(ONSETS <= HIDDEN_LAST_ONSET + 1e-9))]   # the steps come first
+    hidden = _undetected(result, model, mid, scan, bound + float(normal_isf(1 - POWER)))
     details.update(undetected=hidden, hidden=bool(
         hidden["dv_shift_kt"] > max(HIDDEN_RATIO * hidden["dv_2sigma_kt"], MIN_SHIFT_KT)))
     if details["flagged"]:
