@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass, fields, replace
 
 import numpy as np
 
-from pitotcal.core.checks import choice, number, positive
+from pitotcal.core.checks import choice, number, positive, with_overrides
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.geo import check_lat_lon
@@ -383,13 +383,5 @@ def _true_k(model, k):
 def simulation_options(options=None, overrides=None, *, caller="simulate"):
     """`options` (a SimulationOptions, or None for the defaults) with `overrides` (a dict of
     its fields) put in: the overrides win. An unknown name is a TypeError naming `caller`."""
-    overrides = overrides or {}
-    unknown = sorted(set(overrides) - {f.name for f in fields(SimulationOptions)})
-    if unknown:
-        raise TypeError(f"{caller}() got an unexpected keyword argument {unknown[0]!r}")
-    if options is None:
-        return SimulationOptions(**overrides)
-    if not isinstance(options, SimulationOptions):
-        raise PitotcalError(f"options must be a SimulationOptions or None, got "
-                            f"{type(options).__name__}", param="options")
-    return replace(options, **overrides) if overrides else options
+    return with_overrides(SimulationOptions, options, overrides or {}, name="options",
+                          caller=caller)

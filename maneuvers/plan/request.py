@@ -3,13 +3,22 @@ when it is made, before any work; the planner's working copy of it; the node-cou
 the path OCP."""
 
 import logging
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 from .ocp import TURNS
 from .profiles import make_schedule
 
-from pitotcal.core.checks import choice, exact, integer, number, option_dict, positive, round_to_limit
+from pitotcal.core.checks import (
+    choice,
+    exact,
+    integer,
+    number,
+    option_dict,
+    positive,
+    round_to_limit,
+    with_overrides,
+)
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
 from pitotcal.core.plan import PROFILES
@@ -211,10 +220,6 @@ def plan_request(request=None, positional=(), overrides=None, *, caller="plan_ma
     defaults, or the profile of the positional form ``plan_maneuver("two-speed", 70, 90)``)
     with `overrides` (a dict of its fields) put in: the overrides win."""
     overrides = dict(overrides or {})
-    names = {f.name for f in fields(PlanRequest)}
-    unknown = sorted(set(overrides) - names)
-    if unknown:
-        raise TypeError(f"{caller}() got an unexpected keyword argument {unknown[0]!r}")
     if isinstance(request, str):
         positional = (request, *positional)
         request = None
@@ -227,12 +232,7 @@ def plan_request(request=None, positional=(), overrides=None, *, caller="plan_ma
         if name in overrides:
             raise TypeError(f"{caller}() got multiple values for argument {name!r}")
         overrides[name] = value
-    if request is None:
-        return PlanRequest(**overrides)
-    if not isinstance(request, PlanRequest):
-        raise PitotcalError(f"request must be a PlanRequest or None, got "
-                            f"{type(request).__name__}", param="request")
-    return replace(request, **overrides) if overrides else request
+    return with_overrides(PlanRequest, request, overrides, name="request", caller=caller)
 
 
 def working_request(request):

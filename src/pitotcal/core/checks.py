@@ -4,6 +4,7 @@ Each returns the value as a plain Python number or raises a `PitotcalError` that
 parameter (`param`), so the command line can show the flag instead (`--cas-min-kt`).
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -90,3 +91,18 @@ def option_dict(name, value):
 def wrap_deg(angle_deg):
     """An angle difference wrapped into [-180, 180) degrees (arrays too)."""
     return (np.asarray(angle_deg, dtype=float) + 180.0) % 360.0 - 180.0
+
+
+def with_overrides(cls, obj, overrides, *, name, caller):
+    """`obj` (a frozen `cls` dataclass, or None for its defaults) with the fields in the dict
+    `overrides` put in (they win); an unknown field is a TypeError naming `caller`, an `obj` of
+    another type a PitotcalError naming the argument `name`."""
+    unknown = sorted(set(overrides) - {f.name for f in dataclasses.fields(cls)})
+    if unknown:
+        raise TypeError(f"{caller}() got an unexpected keyword argument {unknown[0]!r}")
+    if obj is None:
+        return cls(**overrides)
+    if not isinstance(obj, cls):
+        raise PitotcalError(f"{name} must be a {cls.__name__} or None, got "
+                            f"{type(obj).__name__}", param=name)
+    return dataclasses.replace(obj, **overrides) if overrides else obj
