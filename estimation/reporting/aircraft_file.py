@@ -33,7 +33,7 @@ _KEYS = {table: [k for t, k, _ in AIRCRAFT_FIELDS if t == table] for table in _T
 _FIELD_TYPES = (str, int, float, datetime.date, datetime.time)
 # a key whose name ends so is a speed: never negative
 _SPEED_SUFFIXES = ("_kt", "_kts", "_kias", "_kcas", "_ktas", "_mps", "_kmh", "_kph", "_mph")
-_MISSPELT = 0.8         # difflib ratio from which an unknown name is a misspelt known one
+_MISSPELT = 0.85        # difflib ratio from which an unknown name is a misspelt known one
 
 
 def read_aircraft(path):
@@ -120,8 +120,17 @@ def _check_value(name, value, refuse):
 
 
 def _near(name, candidates):
-    close = difflib.get_close_matches(str(name).lower(), candidates, n=1, cutoff=_MISSPELT)
-    return close[0] if close else None
+    """The known name `name` misspells, or None: a known name with a prefix or suffix added
+    (`weight_kg`, `copilot`) is an extra key of its own, not a misspelling."""
+    low = str(name).lower()
+    close = difflib.get_close_matches(low, candidates, n=1, cutoff=_MISSPELT)
+    if not close:
+        return None
+    known = close[0]
+    added = len(low) - len(known)           # two letters or more: a word of its own
+    if added >= 2 and (low.startswith(known) or low.endswith(known)):
+        return None
+    return known
 
 
 def _type_name(value):

@@ -127,3 +127,12 @@ def test_the_demo_flight_in_si_is_read(demo_columns, tmp_path):
     flight = read_flight(_write(dict(demo_columns), tmp_path / "flight.csv"))
     assert flight.n == demo_columns["time_s"].size and flight.n_dropped == 0
     write_flight_csv(flight, tmp_path / "again.csv")
+
+
+def test_a_1200_hz_log_in_seconds_is_read(tmp_path):
+    """A step of 0.83 ms is a fast log in seconds, not minutes (minutes at 50 Hz step 0.33 ms)."""
+    import pitotcal
+
+    flight, _ = pitotcal.simulate(pitotcal.plan_maneuver(), seed=1, rate_hz=1200.0)
+    path = pitotcal.write_flight_csv(flight, tmp_path / "fast.csv")
+    assert pitotcal.read_flight(path).n == flight.n

@@ -316,12 +316,13 @@ def check_units(name, qci, vn, ve, rho):
         "m/s; check their units")
 
 
-# The time column's unit. A calibration flight is sampled at 0.5-1000 Hz: a median
-# step above 2 "s" is a log in milliseconds or microseconds, one below 1 ms is a log in
-# minutes (50 Hz in minutes is a step of 0.00033); a first time after 1e8 s (1973) is a clock
-# (Unix time), not seconds since the log started.
+# The time column's unit. A calibration flight is sampled at 0.5-2000 Hz: a median
+# step above 2 "s" is a log in milliseconds or microseconds, one below 0.5 ms is a log in
+# minutes (50 Hz in minutes is a step of 0.00033; slower logs in minutes overlap real
+# 1-2 kHz logs and are told by their climb, `check_vertical_speed`); a first time after
+# 1e8 s (1973) is a clock (Unix time), not seconds since the log started.
 _TIME_STEP_MAX_S = 2.0
-_TIME_STEP_MIN_S = 1e-3
+_TIME_STEP_MIN_S = 5e-4
 _UNIX_TIME_MIN_S = 1e8
 
 

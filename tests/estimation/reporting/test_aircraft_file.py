@@ -61,3 +61,11 @@ def test_good_files_are_shown_whole(tmp_path):
     assert rows == [("Aircraft", "DR400"), ("Weight", "1050"), ("Centre of gravity", "-0.02"),
                     ("Test date", "2026-05-04"), ("test.fuel", "full"), ("test.vne_kt", "163"),
                     ("test.ballast", "True"), ("test.pilot_notes", "calm")]
+
+
+def test_a_known_key_with_a_prefix_or_suffix_is_an_extra_key(tmp_path):
+    """`weight_kg`, `serial_no`, `copilot`: keys of their own, shown, not misspellings."""
+    path = tmp_path / "a.toml"
+    path.write_text('[aircraft]\nweight_kg = 1050\nserial_no = "S1"\n[test]\ncopilot = "B"\n')
+    assert [name for name, _ in read_aircraft(path)] == [
+        "aircraft.weight_kg", "aircraft.serial_no", "test.copilot"]
