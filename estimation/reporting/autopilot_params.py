@@ -190,7 +190,7 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
                 f"no parameter recommended: the {model} model departs from one scale by "
                 f"{d['max_departure_kt']:.2f} kt at {d['vi_kt']:.0f} KIAS (its 2 sigma "
                 f"{d['two_sigma_kt']:.2f} kt): a single {name} cannot represent the error "
-                f"over the flown range ({misfit_text(name, misfit)})", misfit)
+                f"over the flown range ({_misfit_brief(misfit)})", misfit)
     grad = gradient(lambda k: _parameter(autopilot, k[0], qref, air), [k1])
     two_sigma = 2.0 * float(band(grad, np.array([[k1_sd ** 2]])))
     _check_bounds(name, value, two_sigma, current, autopilot)
@@ -278,6 +278,13 @@ def _misfit(autopilot, value, const, fits, air_data):
                 "local_min": float(local.min()), "local_max": float(local.max()),
                 "vi_min_kt": float(vi_kt[0]), "vi_max_kt": float(vi_kt[-1])}
     return best
+
+
+def _misfit_brief(m):
+    """The refusal's short form of a structure misfit (never None there: a model departed)."""
+    return (f"one value is off by up to {m['max_dv_kt']:.2f} kt at {m['vi_kt']:.0f} KIAS over "
+            f"{m['vi_min_kt']:.0f}-{m['vi_max_kt']:.0f} KIAS; the local value spans "
+            f"{m['local_min']:.4f} to {m['local_max']:.4f}")
 
 
 def misfit_text(name, misfit):
