@@ -19,11 +19,19 @@ data of a result whose ``air_data`` is "compressible", V_c is the isentropic CAS
 ratio is evaluated at the median q_ci flown (it then drifts by ~(V/a₀)²/4 across speeds,
 0.1 % at 50 kt). The 2σ follows from k1's 2σ (delta method).
 
+Structure misfit. The 2σ is statistical only: one value cannot represent a pressure error that
+changes with speed. Beside it the recommendation states what the single value costs over the
+flown V_i range against the two-coefficient model (inverse or linear, whichever departs more):
+the largest |ΔV_model − ΔV_constant| (kt) with that model's ΔV 2σ there, and the span
+(min–max) of the local ratio/scale the model implies, V_c,model(V_i)² / q_ci(V_i) (PX4:
+V_c / IAS).
+
 Refusals (a `PitotcalError`, exit 2, one line): the track turned through less than
-`MIN_TRACK_SPREAD_DEG`; the constant-model fit did not converge; the inverse or linear model departs from the constant one by more than
-its own 2σ somewhere in the flown range (one scale cannot represent the error: the scale right
-at cruise is wrong near the stall); the 2σ of the new value is wider than `TOLERANCE` of it
-while the current value lies inside that band (the flight cannot improve on it).
+`MIN_TRACK_SPREAD_DEG`; the constant-model fit did not converge; the inverse or linear model
+departs from the constant one by more than its own 2σ somewhere in the flown range (one scale
+cannot represent the error: the scale right at cruise is wrong near the stall; a
+`ParameterRefused` carrying the structure misfit); the 2σ of the new value is wider than
+`TOLERANCE` of it while the current value lies inside that band (the flight cannot improve on it).
 """
 
 from dataclasses import dataclass, field
@@ -36,8 +44,8 @@ from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import RHO0_KGM3
 from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
-__all__ = ["MIN_TRACK_SPREAD_DEG", "TOLERANCE", "ParameterRecommendation", "recommend",
-           "write_parameter_file"]
+__all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "TOLERANCE", "ParameterRecommendation",
+           "ParameterRefused", "misfit_text", "recommend", "write_parameter_file"]
 
 # A parameter is committed only after turning through three quarters of a circle: wind and
 # scale then separate with margin (identify itself needs only more than half a circle).
@@ -47,6 +55,18 @@ MIN_TRACK_SPREAD_DEG = 270.0
 TOLERANCE = 0.01
 # The parameter written when the log has none of its names (PX4: the current name first)
 PARAMETER = {"ArduPilot": ARDUPILOT_RATIO, "PX4": PX4_SCALES[0]}
+# Grid of the structure misfit, kt: fine enough that the largest departure between the flown
+# ends is not missed (the correction table's coarser grid keeps the refusal rule unchanged)
+MISFIT_STEP_KT = 1.0
+
+
+class ParameterRefused(PitotcalError):
+    """No parameter recommended because one value cannot represent the error; `misfit` is the
+    structure misfit (`ParameterRecommendation.misfit`) that says what it would cost."""
+
+    def __init__(self, message, misfit):
+        super().__init__(message)
+        self.misfit = misfit
 
 
 @dataclass(frozen=True)
@@ -71,6 +91,10 @@ class ParameterRecommendation:
     departures : dict
         Model -> {max_departure_kt, two_sigma_kt, vi_kt}: the largest |ΔV_model − ΔV_constant|
         over the flown range relative to the model's 2σ there.
+    misfit : dict or None
+        The structure misfit (module docstring): {model, max_dv_kt, vi_kt, two_sigma_kt,
+        local_min, local_max, vi_min_kt, vi_max_kt}; None when no two-coefficient model was
+        identifiable.
     notes : tuple of str
     """
 
@@ -86,11 +110,22 @@ class ParameterRecommendation:
     track_spread_deg: float
     departures: dict = field(default_factory=dict)
     notes: tuple = ()
+    misfit: dict | None = None
+
+    def misfit_line(self):
+        """The structure misfit in one line (ASCII: it goes into parameter files)."""
+        return misfit_text(self.name, self.misfit)
+
+    def to_dict(self):
+        """The JSON record: name, value, two_sigma, current, structure_misfit."""
+        return {"name": self.name, "value": self.value, "two_sigma": self.two_sigma,
+                "current": self.current, "structure_misfit": self.misfit}
 
     def comments(self):
         """The comment lines of the parameter file."""
         cur = "not in the log" if self.current is None else f"{self.current:.6g}"
         lines = [f"pitotcal: {self.name} = {self.value:.6f} +/- {self.two_sigma:.6f} (2 sigma)",
+                 self.misfit_line(),
                  (f"current value {cur}; constant model k1 = {self.k1:.5f} +/- "
                   f"{self.k1_two_sigma:.5f} (2 sigma), air data {self.air_data}"),
                  f"track turned through {self.track_spread_deg:.0f} deg"]
@@ -142,18 +177,20 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
     if not const.success:
         raise PitotcalError(f"no parameter recommended: the constant-model fit did not "
                             f"converge ({const.message})")
-    departures, notes = _departures(flight, const, noise, air)
-    for model, d in departures.items():
-        if d["max_departure_kt"] > d["two_sigma_kt"]:
-            raise PitotcalError(
-                f"no parameter recommended: the {model} model departs from one scale by "
-                f"{d['max_departure_kt']:.2f} kt at {d['vi_kt']:.0f} KIAS (its 2 sigma "
-                f"{d['two_sigma_kt']:.2f} kt): a single {name} cannot represent the error "
-                "over the flown range")
+    fits, notes = _two_coefficient_fits(flight, noise, air)
+    departures = {m: _departure(const, res) for m, res in fits.items()}
     air = getattr(const, "air_data", None) or "incompressible"
     qref = float(np.median(const.qci_pa))
     k1, k1_sd = const.value("k1"), const.stddev("k1")
     value = _parameter(autopilot, k1, qref, air)
+    misfit = _misfit(autopilot, value, const, fits, air)
+    for model, d in departures.items():
+        if d["max_departure_kt"] > d["two_sigma_kt"]:
+            raise ParameterRefused(
+                f"no parameter recommended: the {model} model departs from one scale by "
+                f"{d['max_departure_kt']:.2f} kt at {d['vi_kt']:.0f} KIAS (its 2 sigma "
+                f"{d['two_sigma_kt']:.2f} kt): a single {name} cannot represent the error "
+                f"over the flown range ({_misfit_brief(misfit)})", misfit)
     grad = gradient(lambda k: _parameter(autopilot, k[0], qref, air), [k1])
     two_sigma = 2.0 * float(band(grad, np.array([[k1_sd ** 2]])))
     _check_bounds(name, value, two_sigma, current, autopilot)
@@ -161,7 +198,7 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
         notes.append("the current value is inside the 2 sigma band: the change is not "
                      "significant, keeping the current value is as good")
     return ParameterRecommendation(autopilot, name, value, two_sigma, current, k1, 2 * k1_sd,
-                                   qref, air, spread, departures, tuple(notes))
+                                   qref, air, spread, departures, tuple(notes), misfit)
 
 
 def _parameter(autopilot, k1, qci_pa, air_data):
@@ -189,28 +226,76 @@ def _check_bounds(name, value, two_sigma, current, autopilot):
             f"of airspeed, need <= {100 * TOLERANCE:g} %) and {where}; fly longer or steadier")
 
 
-def _departures(flight, const, noise, air):
-    """How far the two-coefficient models depart from the constant one over the flown range."""
+def _two_coefficient_fits(flight, noise, air):
+    """The inverse and linear fits the constant one is tested against, and notes on those that
+    could not be identified."""
     from ..identification.identify import identify
 
-    out, notes = {}, []
+    fits, notes = {}, []
     for model in ("inverse", "linear"):
         try:
-            res = identify(flight, model=model, air=air, **noise)
+            fits[model] = identify(flight, model=model, air=air, **noise)
         except ObservabilityError as exc:
             notes.append(f"{model} model not identifiable ({exc}); one scale not tested "
                          "against it")
-            continue
-        rows = res.correction_table()
-        vi = np.array([r["vi_kt"] for r in rows])
+    return fits, notes
+
+
+def _departure(const, res):
+    """How far `res` departs from the constant fit over the flown range, against its 2σ."""
+    rows = res.correction_table()
+    vi = np.array([r["vi_kt"] for r in rows])
+    dv_m = np.array([r["dv_kt"] for r in rows])
+    band = np.array([r["dv_2sigma_kt"] for r in rows])
+    dv_c, _ = const.delta_v_kt(vi)
+    excess = np.abs(dv_m - dv_c) - band
+    i = int(np.argmax(excess))
+    return {"max_departure_kt": float(abs(dv_m[i] - dv_c[i])),
+            "two_sigma_kt": float(band[i]), "vi_kt": float(vi[i])}
+
+
+def _misfit(autopilot, value, const, fits, air_data):
+    """The structure misfit of the single `value` (module docstring), or None without a fit."""
+    from pitotcal.core.airdata import airspeed_law
+    from pitotcal.core.units import kt_to_mps
+
+    best = None
+    for model, res in fits.items():
+        rows = res.correction_table(step_kt=MISFIT_STEP_KT)
+        vi_kt = np.array([r["vi_kt"] for r in rows])
         dv_m = np.array([r["dv_kt"] for r in rows])
-        band = np.array([r["dv_2sigma_kt"] for r in rows])
-        dv_c, _ = const.delta_v_kt(vi)
-        excess = np.abs(dv_m - dv_c) - band
-        i = int(np.argmax(excess))
-        out[model] = {"max_departure_kt": float(abs(dv_m[i] - dv_c[i])),
-                      "two_sigma_kt": float(band[i]), "vi_kt": float(vi[i])}
-    return out, notes
+        dv_c, _ = const.delta_v_kt(vi_kt)
+        err = np.abs(dv_m - dv_c)
+        i = int(np.argmax(err))
+        if best is not None and err[i] <= best["max_dv_kt"]:
+            continue
+        qci = airspeed_law(air_data)[0](kt_to_mps(vi_kt))
+        vc_sq = kt_to_mps(vi_kt + dv_m) ** 2
+        # ArduPilot: ratio = V_c² / q_ci; PX4: scale = V_c / IAS with IAS² = 2 q_ci / ρ₀
+        local = vc_sq / qci if autopilot == "ArduPilot" else np.sqrt(vc_sq * RHO0_KGM3 / (2 * qci))
+        best = {"model": model, "max_dv_kt": float(err[i]), "vi_kt": float(vi_kt[i]),
+                "two_sigma_kt": float(rows[i]["dv_2sigma_kt"]),
+                "local_min": float(local.min()), "local_max": float(local.max()),
+                "vi_min_kt": float(vi_kt[0]), "vi_max_kt": float(vi_kt[-1])}
+    return best
+
+
+def _misfit_brief(m):
+    """The refusal's short form of a structure misfit (never None there: a model departed)."""
+    return (f"one value is off by up to {m['max_dv_kt']:.2f} kt at {m['vi_kt']:.0f} KIAS over "
+            f"{m['vi_min_kt']:.0f}-{m['vi_max_kt']:.0f} KIAS; the local value spans "
+            f"{m['local_min']:.4f} to {m['local_max']:.4f}")
+
+
+def misfit_text(name, misfit):
+    """One ASCII line stating a structure misfit (`ParameterRecommendation.misfit`)."""
+    if misfit is None:
+        return "structure misfit not assessed: no two-coefficient model identifiable"
+    m = misfit
+    return (f"structure misfit over {m['vi_min_kt']:.0f}-{m['vi_max_kt']:.0f} KIAS: one "
+            f"{name} is off the {m['model']} model by up to {m['max_dv_kt']:.2f} kt at "
+            f"{m['vi_kt']:.0f} KIAS (its 2 sigma {m['two_sigma_kt']:.2f} kt); local {name} "
+            f"{m['local_min']:.4f} to {m['local_max']:.4f}")
 
 
 def write_parameter_file(rec, path):

@@ -21,6 +21,37 @@ def test_csv_with_the_autopilot_ratio_comment(flight, tmp_path, capsys):
     assert "current value 1.9936" in out.read_text()
 
 
+def test_the_structure_misfit_is_printed_written_and_recorded(tmp_path, capsys):
+    """A speed-dependent error: the summary, the parameter file and the JSON's
+    autopilot_parameter state what one ratio costs over the flown range, in kt."""
+    import json
+
+    flight = synthetic_flight(seed=5, n=6000, model="inverse", k=(0.02, -40.0),
+                              qc_noise_pa=0.3, turbulence_mps=1.0)[0]
+    path, out, rec = tmp_path / "f.csv", tmp_path / "new.param", tmp_path / "r.json"
+    write_flight_csv(flight, path, comments={"autopilot_ARSPD_RATIO": "1.9936"})
+    assert main(["identify", str(path), "--params", str(out), "--json", str(rec),
+                 "--no-budget"]) == 0
+    misfit = json.loads(rec.read_text())["autopilot_parameter"]["structure_misfit"]
+    assert misfit["model"] in ("inverse", "linear") and 0.5 < misfit["max_dv_kt"] < 1.5
+    line = f"off the {misfit['model']} model by up to {misfit['max_dv_kt']:.2f} kt"
+    assert line in capsys.readouterr().out and line in out.read_text()
+
+
+def test_a_refusal_is_recorded_with_its_misfit(tmp_path, capsys):
+    import json
+
+    flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -40.0))[0]
+    path, rec = tmp_path / "f.csv", tmp_path / "r.json"
+    write_flight_csv(flight, path, comments={"autopilot_ARSPD_RATIO": "1.9936"})
+    assert main(["identify", str(path), "--params", str(tmp_path / "p.param"), "--json",
+                 str(rec), "--no-budget"]) == 2
+    record = json.loads(rec.read_text())["autopilot_parameter"]
+    assert record["refused"].startswith("no parameter recommended: ")
+    assert record["structure_misfit"]["max_dv_kt"] > 0.3
+    assert "kt at" in capsys.readouterr().err
+
+
 def test_csv_without_autopilot_is_refused(flight, tmp_path, capsys):
     path = tmp_path / "f.csv"
     write_flight_csv(flight, path)

@@ -194,16 +194,17 @@ def run(args):
 
     # every file is written before anything is printed, so a reader that goes away early
     # (`| head`) never costs a file
-    if args.json is not None:       # the record, with the path as given (a log's names the file)
-        write_json(args.json, {**result.to_dict(), "source": str(source)})
-    if plot_path is not None:
-        _write_plot(plot_path, result, budget)
     params, refused = None, None
     if args.params is not None:
         try:
             params = _write_params(args, flight, autopilot, current)
         except PitotcalError as exc:        # said after the summary
             refused = exc
+    if args.json is not None:       # the record, with the path as given (a log's names the file)
+        write_json(args.json, {**result.to_dict(), "source": str(source),
+                               **_params_record(args, params, refused)})
+    if plot_path is not None:
+        _write_plot(plot_path, result, budget)
 
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
@@ -295,10 +296,22 @@ def _write_params(args, flight, autopilot, current):
     return rec
 
 
+def _params_record(args, rec, refused):
+    """The JSON's ``autopilot_parameter`` (docs/interfaces.md §13): the recommendation, or why
+    none, with the structure misfit; nothing without --params."""
+    if args.params is None:
+        return {}
+    if rec is not None:
+        return {"autopilot_parameter": rec.to_dict()}
+    return {"autopilot_parameter": {"refused": str(refused),
+                                    "structure_misfit": getattr(refused, "misfit", None)}}
+
+
 def _print_params(rec, path):
     print(f"\nRecommended {rec.name} = {rec.value:.4f} ± {rec.two_sigma:.4f} (2σ)"
           + ("" if rec.current is None else f", now {rec.current:.6g}")
           + f"; wrote {path}")
+    print(f"  {rec.misfit_line()}")
     for note in rec.notes:
         print(f"  note: {note}")
 

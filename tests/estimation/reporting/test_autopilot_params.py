@@ -2,9 +2,12 @@
 files read back by pymavlink's own loader and by a QGC parse, the SITL log, the refusals."""
 
 import math
+import re
 
+import numpy as np
 import pytest
-from pitotcal.estimation.reporting.autopilot_params import recommend, write_parameter_file
+from pitotcal.estimation.reporting.autopilot_params import (ParameterRefused, recommend,
+                                                            write_parameter_file)
 from synthetic import synthetic_flight
 
 from pitotcal.core.errors import PitotcalError
@@ -64,8 +67,59 @@ def test_refuses_a_track_that_did_not_turn_enough():
 def test_refuses_when_one_scale_cannot_represent_the_error():
     # Δp/q_c from -0.05 at 70 kt to -0.02 at 100 kt: the inverse model departs from one scale
     flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -40.0))[0]
-    with pytest.raises(PitotcalError, match="a single ARSPD_RATIO cannot represent"):
+    with pytest.raises(PitotcalError, match="a single ARSPD_RATIO cannot represent") as exc:
         recommend(flight, "ArduPilot", current=1.9936)
+    # the refusal states what one ratio would cost, in kt, and carries it
+    assert re.search(r"one value is off by up to \d+\.\d\d kt at \d+ KIAS", str(exc.value))
+    assert isinstance(exc.value, ParameterRefused) and exc.value.misfit["max_dv_kt"] > 0.3
+
+
+def _true_misfit(model, k, const, misfit):
+    """What the recommended single value costs against the true error over the same V_i range:
+    the largest |ΔV_true − ΔV_constant fit| and the span of the true local ratio."""
+    from pitotcal.core.models import delta_v_kt, get_model
+    from pitotcal.core.units import kt_to_mps
+
+    vi = np.linspace(misfit["vi_min_kt"], misfit["vi_max_kt"], 301)
+    dv_true = delta_v_kt(get_model(model), k, vi)
+    dv_const, _ = const.delta_v_kt(vi)
+    ratio = kt_to_mps(vi + dv_true) ** 2 / (0.5 * RHO0_KGM3 * kt_to_mps(vi) ** 2)
+    return float(np.max(np.abs(dv_true - dv_const))), float(ratio.max() - ratio.min())
+
+
+def _ratio_bound(rec):
+    # a ΔV error δ at V_i moves the local ratio V_c²/q_ci by about 2 δ / V_i of itself
+    m = rec.misfit
+    return 2.0 * m["two_sigma_kt"] / m["vi_min_kt"] * rec.value
+
+
+def test_structure_misfit_of_a_speed_dependent_error_matches_the_truth():
+    """The campaign's case: a ratio stated +/- 0.03 (2 sigma) whose true local value spans
+    1.587-1.625 over 71-100 KIAS. The recommendation states the misfit beside its 2 sigma."""
+    from pitotcal import identify
+
+    k = (0.02, -40.0)
+    flight = synthetic_flight(seed=5, n=6000, model="inverse", k=k, qc_noise_pa=0.3,
+                              turbulence_mps=1.0)[0]
+    rec = recommend(flight, "ArduPilot", current=1.9936)
+    true_dv, true_span = _true_misfit("inverse", k, identify(flight, model="constant"),
+                                      rec.misfit)
+    m = rec.misfit
+    assert true_dv > 0.8 and true_span > 0.02 * rec.value     # a real structure error
+    assert abs(m["max_dv_kt"] - true_dv) <= m["two_sigma_kt"]
+    assert abs((m["local_max"] - m["local_min"]) - true_span) <= _ratio_bound(rec)
+    assert m["local_min"] < rec.value < m["local_max"]
+    text = "\n".join(rec.comments())
+    assert f"by up to {m['max_dv_kt']:.2f} kt" in text and f"{m['local_min']:.4f} to" in text
+    assert rec.to_dict()["structure_misfit"] == m
+
+
+def test_structure_misfit_of_a_constant_error_is_nil(constant_flight):
+    rec = recommend(constant_flight, "ArduPilot", current=1.6)
+    m = rec.misfit
+    assert m["max_dv_kt"] <= m["two_sigma_kt"]
+    assert m["local_max"] - m["local_min"] <= _ratio_bound(rec)
+    assert m["local_min"] <= rec.value <= m["local_max"]
 
 
 def test_refuses_bounds_too_wide_to_improve_on_the_current_value():
