@@ -53,21 +53,27 @@ def budget_summary(result, budget):
         f"  {'KIAS':>7}{'ΔV kt':>9}{'±2σ kt':>9}{'±U kt':>9}{'KCAS':>8}",
     ]
     for v, d, s2, u in zip(budget.vi_kt, dv, two_sigma, budget.expanded_kt):
-        lines.append(f"  {v:7.1f}{d:+9.2f}{s2:9.2f}{u:9.2f}{v + d:8.1f}")
+        lines.append(f"  {v:7.1f}{d:+9.2f}{s2:9.2f}{_num(u, 9, 2)}{v + d:8.1f}")
     names = list(budget.terms_kt)
     lines += ["", "  standard uncertainty of ΔV by source, kt:",
               f"  {'KIAS':>7}{'stat':>7}" + "".join(f"{_HEADS.get(n, n)[:6]:>7}" for n in names)
               + f"{'u_c':>7}"]
     for i, v in enumerate(budget.vi_kt):
-        terms = "".join(f"{budget.terms_kt[n][i]:7.3f}" for n in names)
+        terms = "".join(_num(budget.terms_kt[n][i], 7, 3) for n in names)
         lines.append(f"  {v:7.1f}{budget.statistical_kt[i]:7.3f}{terms}"
-                     f"{budget.combined_kt[i]:7.3f}")
+                     f"{_num(budget.combined_kt[i], 7, 3)}")
     lines += ["", f"  {'source':<20}{'input u':>14}{'max u(ΔV) kt':>15}"]
     for row in budget.to_list():
         given = (f"{row['u_input']:.4g} {row['unit']}" if "u_input" in row
                  else "(2σ / 2)")
-        lines.append(f"  {row['source']:<20}{given:>14}{row['u_dv_kt']:15.3f}")
+        lines.append(f"  {row['source']:<20}{given:>14}{_num(row['u_dv_kt'], 15, 3)}")
     return "\n".join(lines)
+
+
+def _num(x, width, digits):
+    """`x` right-aligned in `width` with `digits` decimals, or "n/a" (a term not computed)."""
+    ok = x is not None and np.isfinite(x)
+    return f"{x:{width}.{digits}f}" if ok else f"{'n/a':>{width}}"
 
 
 def budget_report(result):

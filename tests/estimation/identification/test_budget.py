@@ -112,3 +112,15 @@ def test_resolves_are_identify_without_the_bounds(fitted):
     np.testing.assert_array_equal(quick.residuals_pa, full.residuals_pa)
     np.testing.assert_array_equal(quick.covariance, full.covariance_plain)
     assert quick.consistency == {} and full.consistency
+
+
+def test_a_term_not_computed_prints_n_a(fitted, budget):
+    """A term whose re-solve was refused is NaN in the budget: its text table says n/a, never
+    nan."""
+    from pitotcal.estimation.reporting.budget_tables import budget_summary
+
+    name = next(iter(budget.terms_kt))
+    terms = {**budget.terms_kt, name: np.full_like(budget.terms_kt[name], np.nan)}
+    spoiled = dataclasses.replace(budget, terms_kt=terms)     # u_c and U then NaN too
+    text = budget_summary(fitted[1], spoiled)
+    assert "nan" not in text and "n/a" in text
