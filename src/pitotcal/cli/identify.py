@@ -45,6 +45,11 @@ def add_parser(subparsers):
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
     add_reading_arguments(p)
+    p.add_argument("--columns", metavar="MAP.toml", default=None,
+                   help="read FLIGHT as any CSV export through this column mapping (TOML: "
+                        "which column is time, GPS velocity, total or impact pressure, static "
+                        "pressure, total or static temperature, GPS height, each with its unit; "
+                        "docs/interfaces.md section 1b)")
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
@@ -245,7 +250,11 @@ def _read(args, source):
     air = {"oat_k": oat_k_from_c(args.oat_c), "temp_recovery": args.temp_recovery,
            "rh_pct": args.rh_percent}
     if args.params is None:
-        return read_flight(source, start_s=args.start_s, end_s=args.end_s, **air), None, {}
+        return read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                           columns=getattr(args, "columns", None), **air), None, {}
+    if getattr(args, "columns", None) is not None:
+        raise PitotcalError("--params reads an autopilot log; --columns maps a CSV export: "
+                            "give one of them", param="columns")
     from pitotcal.io.param_files import read_flight_and_parameters
     flight, autopilot, current = read_flight_and_parameters(source, args.start_s, args.end_s,
                                                             **air)
