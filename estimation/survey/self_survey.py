@@ -40,7 +40,8 @@ from pitotcal.core.units import G0_MPS2, ISA_LAPSE_KPM, R_AIR_JKGK
 
 from ..uncertainty.covariance import colored_covariance
 
-__all__ = ["LAPSE_SIGMA_KPM", "MACH_IC_FIT_MAX", "SelfSurveyResult", "self_survey"]
+__all__ = ["LAPSE_SIGMA_KPM", "MACH_IC_FIT_MAX", "SelfSurveyResult", "hydrostatic_pressure_pa",
+           "self_survey"]
 
 MACH_IC_FIT_MAX = 0.95
 LAPSE_SIGMA_KPM = 0.003          # a real profile's lapse rate, 1σ about the standard one
@@ -170,11 +171,26 @@ def _data(flight):
             "n_super": int(np.count_nonzero(ratio > _MACH_1_RATIO))}
 
 
+def hydrostatic_pressure_pa(h_m, h_ref_m, p_ref_pa, t_ref_k, lapse_kpm=ISA_LAPSE_KPM):
+    """Static pressure at geometric height `h_m` by the hydrostatic equation, Pa.
+
+    Notes
+    -----
+    With T(h) = T_ref − L (h − h_ref) and constant gravity g₀,
+    p(h) = p_ref (T(h) / T_ref)^(g₀ / (R L)); L = 0 is the isothermal
+    p_ref exp(−g₀ (h − h_ref) / (R T_ref)).
+    """
+    dh = np.asarray(h_m, dtype=float) - h_ref_m
+    if lapse_kpm == 0.0:
+        return p_ref_pa * np.exp(-G0_MPS2 * dh / (R_AIR_JKGK * t_ref_k))
+    t_h = t_ref_k - lapse_kpm * dh
+    return p_ref_pa * (t_h / t_ref_k) ** (G0_MPS2 / (R_AIR_JKGK * lapse_kpm))
+
+
 def _static_pa(data, x, profile):
-    """True static pressure along the path by the hydrostatic equation, Pa."""
-    t_mean, lapse = profile
-    t_h = t_mean - lapse * (data["h_m"] - data["h_ref_m"])
-    return data["ps_mean_pa"] * (1.0 + x[0]) * (t_h / t_mean) ** (G0_MPS2 / (R_AIR_JKGK * lapse))
+    """True static pressure along the path from the unknowns `x`, Pa."""
+    return hydrostatic_pressure_pa(data["h_m"], data["h_ref_m"],
+                                   data["ps_mean_pa"] * (1.0 + x[0]), *profile)
 
 
 def _true_mach(data, p):
