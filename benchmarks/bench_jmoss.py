@@ -38,6 +38,10 @@ total_pressure    = { column = "total_pres_psi",  unit = "psi" }
 static_pressure   = { column = "static_pres_psi", unit = "psi" }
 total_temperature = { column = "total_temp_K",    unit = "K" }
 gps_height        = { column = "height_ft",       unit = "ft" }
+roll              = { column = "roll_angle_rad",   unit = "rad" }
+pitch             = { column = "pitch_angle_rad",  unit = "rad" }
+true_heading      = { column = "true_heading_rad", unit = "rad" }
+sideslip          = { column = "aos_rad",          unit = "rad" }
 """
 GRID = [0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 1.0]
 
@@ -113,7 +117,7 @@ def run_pitotcal(files, sounding_path):
     from pitotcal.estimation.identification.identify import identify
     from pitotcal.estimation.survey import self_survey
     from pitotcal.io import read_flight
-    from pitotcal.io.mapped_csv import read_mapped_csv
+    from pitotcal.io.mapped_csv import read_attitude, read_mapped_csv
     from pitotcal.io.radiosonde import read_sounding
 
     sonde = read_sounding(sounding_path) if sounding_path.exists() else None
@@ -124,12 +128,16 @@ def run_pitotcal(files, sounding_path):
         mapping.write_text(MAPPING)
         for path in files:
             survey = self_survey(read_mapped_csv(path, mapping, mach_ic_max=1.0))
+            vector = self_survey(read_mapped_csv(path, mapping, mach_ic_max=1.0),
+                                 attitude=read_attitude(path, mapping))
             flight = read_flight(path, columns=mapping)
             oe = identify(flight, model="inverse")
             wn, we = _wind_ne(oe)
             entry = {"self_survey": {**survey.to_dict(),
                                      "wind_ne_kt": [float(mps_to_kt(survey.wind_n_mps)),
                                                     float(mps_to_kt(survey.wind_e_mps))]},
+                     "self_survey_vector": {**vector.to_dict(), "wind_ne_kt": [
+                         float(mps_to_kt(vector.wind_n_mps)), float(mps_to_kt(vector.wind_e_mps))]},
                      "output_error": {"k1": oe.value("k1"), "k2": oe.value("k2"),
                                       "wind_ne_kt": [float(mps_to_kt(wn)), float(mps_to_kt(we))],
                                       "wind_speed_2sigma_kt": float(mps_to_kt(
@@ -188,6 +196,8 @@ def _summary(result):
         for method, wind, oat in (("jmoss", r["jmoss"]["wind_ned_kt"][:2], r["jmoss"]["oat_k"]),
                                   ("self_survey", r["self_survey"]["wind_ne_kt"],
                                    r["self_survey"]["oat_k"]),
+                                  ("self_survey_vector", r["self_survey_vector"]["wind_ne_kt"],
+                                   r["self_survey_vector"]["oat_k"]),
                                   ("output_error", r["output_error"]["wind_ne_kt"],
                                    r["output_error"]["oat_k_assumed_r1"])):
             row[method] = {"wind_ne_kt": [round(w, 2) for w in wind], "oat_k": round(oat, 2)}

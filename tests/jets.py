@@ -10,3 +10,10 @@ static_pressure   = { column = "static_pres_psi", unit = "psi" }
 total_temperature = { column = "total_temp_K",    unit = "K" }
 gps_height        = { column = "height_ft",       unit = "ft" }
 """
+# the attitude and sideslip vane, for the self-survey's vector airspeed
+JMOSS_ATTITUDE_MAP = JMOSS_MAP + """\
+roll              = { column = "roll_angle_rad",   unit = "rad" }
+pitch             = { column = "pitch_angle_rad",  unit = "rad" }
+true_heading      = { column = "true_heading_rad", unit = "rad" }
+sideslip          = { column = "aos_rad",          unit = "rad" }
+"""

@@ -17,6 +17,8 @@ W (north, east) and r; every sample then gives its own static position error
 
     Δp_p / p_s = (p_s − p(h)) / p_s    against    M_ic = M(p_t − p_s, p_s),
 
+(with the attitude and the sideslip vane given, the airspeed is compared as a vector,
+V_t u + W = V_g, u its direction from `airspeed_direction`, and the vertical wind is fitted too)
 with no model of how Δp_p depends on M_ic: the curve is whatever the data say, through the
 transonic region. Samples with M_ic above `MACH_IC_FIT_MAX` enter the curve but not the fit
 (their true Mach number may pass 1, where the subsonic pitot relation of the fit does not
@@ -39,6 +41,7 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import G0_MPS2, ISA_LAPSE_KPM, R_AIR_JKGK
 
 from ..uncertainty.covariance import colored_covariance
+from .airspeed_direction import airspeed_direction, aligned_attitude
 
 __all__ = ["LAPSE_SIGMA_KPM", "MACH_IC_FIT_MAX", "SelfSurveyResult", "hydrostatic_pressure_pa",
            "self_survey"]
@@ -46,7 +49,9 @@ __all__ = ["LAPSE_SIGMA_KPM", "MACH_IC_FIT_MAX", "SelfSurveyResult", "hydrostati
 MACH_IC_FIT_MAX = 0.95
 LAPSE_SIGMA_KPM = 0.003          # a real profile's lapse rate, 1σ about the standard one
 _MACH_1_RATIO = float(qc_from_mach_pa(1.0, 1.0))
-_SCALE = np.array([1e-2, 1.0, 1.0, 1.0])      # unknowns: (p_ref/p̄_s − 1), W_n, W_e, r
+# unknowns: (p_ref/p̄_s − 1), W_n, W_e, r, and W_d with the vector airspeed
+_SCALE = np.array([1e-2, 1.0, 1.0, 1.0, 1.0])
+_NAMES = ("p_ref_pa", "wind_n_mps", "wind_e_mps", "recovery", "wind_d_mps")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -60,8 +65,11 @@ class SelfSurveyResult:
     wind_n_mps, wind_e_mps, recovery, p_ref_pa : float
         The fitted wind (the air mass's velocity, north and east), the probe's recovery
         factor and the true static pressure at the median GPS height `h_ref_m`.
-    covariance : ndarray (4, 4)
-        Of (p_ref_pa, wind_n_mps, wind_e_mps, recovery).
+    covariance : ndarray (4, 4) or (5, 5)
+        Of (p_ref_pa, wind_n_mps, wind_e_mps, recovery[, wind_d_mps]).
+    airspeed_model : str
+        "magnitude" (|V_g − W| = V_t) or "vector" (attitude and vanes point V_t; `wind_d_mps`
+        fitted).
     oat_k, oat_2sigma_k : float
         The test point's mean static temperature and its 2σ.
     mach_ic, dpp_ps : ndarray
@@ -86,16 +94,20 @@ class SelfSurveyResult:
     spe: list
     n_fit: int
     n_excluded_supersonic: int
+    airspeed_model: str = "magnitude"
+    wind_d_mps: float = 0.0
 
     def std(self, name):
-        """1σ of "p_ref_pa", "wind_n_mps", "wind_e_mps" or "recovery"."""
-        i = ("p_ref_pa", "wind_n_mps", "wind_e_mps", "recovery").index(name)
-        return float(np.sqrt(self.covariance[i, i]))
+        """1σ of "p_ref_pa", "wind_n_mps", "wind_e_mps", "recovery" or "wind_d_mps"."""
+        i = _NAMES.index(name)
+        return float(np.sqrt(self.covariance[i, i])) if i < len(self.covariance) else 0.0
 
     def to_dict(self):
         """The JSON-ready summary (no per-sample arrays)."""
         return {"method": "self_survey", "success": self.success, "message": self.message,
+                "airspeed_model": self.airspeed_model,
                 "wind_n_mps": self.wind_n_mps, "wind_e_mps": self.wind_e_mps,
+                "wind_d_mps": self.wind_d_mps,
                 "wind_2sigma_mps": 2.0 * max(self.std("wind_n_mps"), self.std("wind_e_mps")),
                 "recovery": self.recovery, "recovery_2sigma": 2.0 * self.std("recovery"),
                 "p_ref_pa": self.p_ref_pa, "h_ref_m": self.h_ref_m, "oat_k": self.oat_k,
@@ -103,7 +115,8 @@ class SelfSurveyResult:
                 "n_excluded_supersonic": self.n_excluded_supersonic, "spe": self.spe}
 
 
-def self_survey(flight, *, bin_width=0.025, height_drift_m=1.0, oat_sigma_k=2.0):
+def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
+                oat_sigma_k=2.0):
     """Static position error Δp_p/p_s against M_ic by the self-survey (module notes).
 
     Parameters
@@ -111,6 +124,11 @@ def self_survey(flight, *, bin_width=0.025, height_drift_m=1.0, oat_sigma_k=2.0)
     flight : Flight
         With `ps_pa` (the static port), `alt_m` (GPS geometric height, m) and `tat_k` (a
         total-temperature probe); `qci_pa` the measured p_t − p_s.
+    attitude : dict of ndarray, optional
+        `time_s`, `roll_rad`, `pitch_rad`, `heading_rad` (true) and optionally `sideslip_rad`
+        (the vane), e.g. from `pitotcal.io.mapped_csv.read_attitude`: the airspeed is then
+        compared with GPS as a vector (`airspeed_direction`), and the vertical wind fitted.
+        Without it, as a magnitude.
     bin_width : float
         Width of the M_ic bins of the curve.
     height_drift_m : float
@@ -125,16 +143,18 @@ def self_survey(flight, *, bin_width=0.025, height_drift_m=1.0, oat_sigma_k=2.0)
     bin_width = checks.number("bin_width", bin_width, 1e-3, 0.5)
     height_drift_m = checks.number("height_drift_m", height_drift_m, 0.0, 100.0)
     oat_sigma_k = checks.number("oat_sigma_k", oat_sigma_k, 0.0, 50.0)
-    data = _data(flight)
+    data = _data(flight, attitude)
     fit = data["ratio"] <= float(qc_from_mach_pa(MACH_IC_FIT_MAX, 1.0))
     profile = (data["oat0_k"], ISA_LAPSE_KPM)
-    sol = least_squares(_residual, np.array([0.0, 0.0, 0.0, 1.0]) / _SCALE, x_scale=1.0,
-                        args=(data, fit, profile), method="trf")
-    x = sol.x * _SCALE
+    scale = _SCALE[:5 if "u" in data else 4]
+    start = np.array([0.0, 0.0, 0.0, 1.0, 0.0])[:scale.size]
+    sol = least_squares(_residual, start / scale, x_scale=1.0, args=(data, fit, profile),
+                        method="trf")
+    x = sol.x * scale
     cov_x = colored_covariance(sol.jac, sol.fun, window="exponential").covariance \
-        * np.outer(_SCALE, _SCALE)
+        * np.outer(scale, scale)
     p_ref = data["ps_mean_pa"] * (1.0 + x[0])
-    to_pa = np.diag([data["ps_mean_pa"], 1.0, 1.0, 1.0])
+    to_pa = np.diag([data["ps_mean_pa"], *np.ones(scale.size - 1)])
     cov = to_pa @ cov_x @ to_pa
     oat = _static_temperature(data, _static_pa(data, x, profile), x[3])
     dpp = _dpp_ps(data, x, profile)
@@ -146,11 +166,14 @@ def self_survey(flight, *, bin_width=0.025, height_drift_m=1.0, oat_sigma_k=2.0)
         h_ref_m=float(data["h_ref_m"]), covariance=cov, oat_k=float(np.mean(oat)),
         oat_2sigma_k=float(oat_2s), mach_ic=data["mach_ic"], dpp_ps=dpp,
         spe=_binned(data["mach_ic"], dpp, spread, bin_width, data["time_s"]),
-        n_fit=int(np.count_nonzero(fit)), n_excluded_supersonic=data["n_super"])
+        n_fit=int(np.count_nonzero(fit)), n_excluded_supersonic=data["n_super"],
+        airspeed_model="vector" if "u" in data else "magnitude",
+        wind_d_mps=float(x[4]) if x.size > 4 else 0.0)
 
 
-def _data(flight):
-    """The arrays the survey needs, SI, samples up to M_ic 1."""
+def _data(flight, attitude=None):
+    """The arrays the survey needs, SI, samples up to M_ic 1; `u` the airspeed's direction
+    when the attitude is given."""
     for name in ("ps_pa", "alt_m", "tat_k"):
         if getattr(flight, name) is None:
             raise PitotcalError(f"`flight` has no {name}: the self-survey needs the static "
@@ -162,12 +185,17 @@ def _data(flight):
     vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(ps.size)
     h = np.asarray(flight.alt_m, dtype=float)[keep]
     oat0 = np.asarray(flight.tat_k)[keep] / (1.0 + 0.2 * mach_from_qc(ratio[keep], 1.0) ** 2)
-    return {"time_s": np.asarray(flight.time_s)[keep], "ps_pa": ps[keep],
+    vg = np.column_stack([flight.gps_vn_mps, flight.gps_ve_mps, vd])[keep]
+    extra = {}
+    if attitude is not None:
+        att = aligned_attitude(attitude, np.asarray(flight.time_s)[keep])
+        extra["u"] = airspeed_direction(att, vg)
+    return {**extra, "time_s": np.asarray(flight.time_s)[keep], "ps_pa": ps[keep],
             "pt_pa": ps[keep] + np.asarray(flight.qci_pa)[keep], "tat_k": flight.tat_k[keep],
             "h_m": h, "h_ref_m": float(np.median(h)), "ratio": ratio[keep],
             "mach_ic": mach_from_qc(ratio[keep], 1.0), "ps_mean_pa": float(np.mean(ps[keep])),
             "oat0_k": float(np.mean(oat0)),
-            "vg": np.column_stack([flight.gps_vn_mps, flight.gps_ve_mps, vd])[keep],
+            "vg": vg,
             "n_super": int(np.count_nonzero(ratio > _MACH_1_RATIO))}
 
 
@@ -203,10 +231,14 @@ def _static_temperature(data, p, recovery):
 
 
 def _residual(xs, data, fit, profile):
-    """V_t from the pressures minus |V_g − W|, m/s, on the fitted samples."""
-    x = xs * _SCALE
+    """V_t from the pressures minus |V_g − W| (magnitude), or V_t u + W − V_g stacked north,
+    east, down (vector), m/s, on the fitted samples."""
+    x = xs * _SCALE[:xs.size]
     p = _static_pa(data, x, profile)
     tas = _true_mach(data, p) * np.sqrt(GAMMA * R_AIR_JKGK * _static_temperature(data, p, x[3]))
+    if "u" in data:
+        air = tas[:, None] * data["u"] + np.array([x[1], x[2], x[4]]) - data["vg"]
+        return air[fit].ravel(order="F")
     air = data["vg"] - np.array([x[1], x[2], 0.0])
     return (tas - np.linalg.norm(air, axis=1))[fit]
 
@@ -217,8 +249,9 @@ def _dpp_ps(data, x, profile):
 
 def _term_spreads(data, x, cov_x, profile, drift_m, oat_sigma_k):
     """Per-sample 1σ of Δp_p/p_s from the unknowns, the height drift and the profile."""
+    steps = np.diag(_SCALE[:x.size] * 1e-3)
     jac = np.column_stack([(_dpp_ps(data, x + d, profile) - _dpp_ps(data, x - d, profile))
-                           / (2.0 * d[i]) for i, d in enumerate(np.diag(_SCALE * 1e-3))])
+                           / (2.0 * d[i]) for i, d in enumerate(steps)])
     var = np.einsum("ij,jk,ik->i", jac, cov_x, jac)
     t_mean, lapse = profile
     var += (drift_m * G0_MPS2 / (R_AIR_JKGK * t_mean)) ** 2
@@ -232,7 +265,7 @@ def _oat_var(data, x, cov_x, profile):
     def mean_oat(xx):
         return np.mean(_static_temperature(data, _static_pa(data, xx, profile), xx[3]))
     grad = np.array([(mean_oat(x + d) - mean_oat(x - d)) / (2.0 * d[i])
-                     for i, d in enumerate(np.diag(_SCALE * 1e-3))])
+                     for i, d in enumerate(np.diag(_SCALE[:x.size] * 1e-3))])
     return float(grad @ cov_x @ grad)
 
 

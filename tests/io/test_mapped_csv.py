@@ -131,3 +131,19 @@ def test_real_jet_exports_load_as_they_are(point, n, left_out, shared_file, tmp_
     assert flight.n == n and flight.meta["excluded_supersonic"] == left_out
     assert any("above M_ic 0.95" in str(w.message) for w in caught)
     assert 5900 < np.median(flight.alt_m) < 6600 and 4e4 < np.median(flight.ps_pa) < 5.5e4
+
+
+def test_attitude_needs_roll_pitch_and_heading(export, tmp_path):
+    from pitotcal.io.mapped_csv import read_attitude
+
+    path, _, _, _ = export
+    mapping = _map_with(tmp_path, MAP + 'roll = { column = "vn_fps", unit = "deg" }\n')
+    with pytest.raises(PitotcalError, match="key pitch: missing"):
+        read_attitude(path, mapping)
+    full = _map_with(tmp_path, MAP + 'roll = { column = "vn_fps", unit = "deg" }\n'
+                     'pitch = { column = "ve_kt", unit = "rad" }\n'
+                     'true_heading = { column = "vd_fps", unit = "deg" }\n')
+    got = read_attitude(path, full)
+    flight = read_flight(path, columns=full)          # angles are not flight columns
+    assert got["roll_rad"] == pytest.approx(np.radians(flight.gps_vn_mps / FT_TO_M), rel=1e-9)
+    assert got["time_s"] == pytest.approx(flight.time_s) and "sideslip_rad" not in got

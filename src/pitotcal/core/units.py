@@ -15,6 +15,7 @@ __all__ = [
     "KT_TO_MPS",
     "NM_TO_M",
     "PA_PER_UNIT",
+    "RAD_PER_UNIT",
     "M_PER_UNIT",
     "MPS_PER_UNIT",
     "S_PER_UNIT",
@@ -49,12 +50,13 @@ S_PER_UNIT = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "min": 60.0}
 MPS_PER_UNIT = {"m/s": 1.0, "ft/s": FT_TO_M, "kt": KT_TO_MPS, "km/h": 1.0 / 3.6,
                 "mph": 0.44704, "cm/s": 0.01}
 M_PER_UNIT = {"m": 1.0, "ft": FT_TO_M, "km": 1000.0}
+RAD_PER_UNIT = {"rad": 1.0, "deg": np.pi / 180.0}
 PA_PER_UNIT = {"Pa": 1.0, "hPa": 100.0, "mbar": 100.0, "mb": 100.0, "kPa": 1000.0,
                "psi": PSI_TO_PA, "psf": PSI_TO_PA / 144.0, "inHg": 3386.389,
                "mmHg": 133.3224, "inH2O": 249.089}
 # temperature: (scale, offset) with T_K = scale * value + offset
-TEMPERATURE_UNITS = {"K": (1.0, 0.0), "degC": (1.0, 273.15), "degF": (5.0 / 9.0, 459.67 * 5.0 / 9.0),
-                     "degR": (5.0 / 9.0, 0.0)}
+TEMPERATURE_UNITS = {"K": (1.0, 0.0), "degC": (1.0, 273.15),
+                     "degF": (5.0 / 9.0, 459.67 * 5.0 / 9.0), "degR": (5.0 / 9.0, 0.0)}
 
 
 def kt_to_mps(v_kt):

@@ -14,7 +14,9 @@ A small TOML file says which column of the export is which quantity and in what 
 `read_mapped_csv` converts the mapped columns to SI (the unit tables of `pitotcal.core.units`),
 forms the impact pressure q_ci = p_t − p_s from a total pressure, and hands the result to the
 flight-CSV reader, so every check of a flight CSV (units, time order, bad rows) applies; a
-message about a flight column also names the export's column it came from.
+message about a flight column also names the export's column it came from. The attitude keys
+(`roll`, `pitch`, `true_heading`, `sideslip`; rad or deg) are not flight columns: `read_attitude`
+reads them for the self-survey's vector airspeed.
 
 Samples above `MACH_IC_MAX` (0.95, the Mach number of the measured pressures) are left out
 with one warning: the air-data relations here are the subsonic (isentropic) ones until the
@@ -33,13 +35,14 @@ import numpy as np
 
 from pitotcal.core.airdata import qc_from_mach_pa
 from pitotcal.core.errors import FlightDataError, PitotcalError
-from pitotcal.core.units import (M_PER_UNIT, MPS_PER_UNIT, PA_PER_UNIT, S_PER_UNIT,
-                                 TEMPERATURE_UNITS)
+from pitotcal.core.units import (M_PER_UNIT, MPS_PER_UNIT, PA_PER_UNIT, RAD_PER_UNIT,
+                                 S_PER_UNIT, TEMPERATURE_UNITS)
 
 from .flight_csv import read_flight_csv
 from .read_once import InputBytes, open_binary, read_once
 
-__all__ = ["MACH_IC_MAX", "MAPPING_KEYS", "SUPERSONIC_NOTE", "read_column_map", "read_mapped_csv"]
+__all__ = ["ATTITUDE_KEYS", "MACH_IC_MAX", "MAPPING_KEYS", "SUPERSONIC_NOTE", "read_attitude",
+           "read_column_map", "read_mapped_csv"]
 
 # mapping key -> (flight CSV column, unit table, what it is)
 MAPPING_KEYS = {
@@ -54,7 +57,13 @@ MAPPING_KEYS = {
     "total_temperature": ("tat_k", TEMPERATURE_UNITS, "total-temperature probe"),
     "static_temperature": ("oat_k", TEMPERATURE_UNITS, "outside (static) air temperature"),
     "gps_height": ("alt_m", M_PER_UNIT, "GPS geometric height"),
+    "roll": ("roll_rad", RAD_PER_UNIT, "roll angle"),
+    "pitch": ("pitch_rad", RAD_PER_UNIT, "pitch angle"),
+    "true_heading": ("heading_rad", RAD_PER_UNIT, "true heading"),
+    "sideslip": ("sideslip_rad", RAD_PER_UNIT, "sideslip vane angle"),
 }
+# not flight CSV columns: read by `read_attitude` for the self-survey's vector airspeed
+ATTITUDE_KEYS = ("roll", "pitch", "true_heading", "sideslip")
 _REQUIRED = ("time", "gps_vn", "gps_ve", "static_pressure")
 _ONE_OF = (("total_pressure", "impact_pressure"), ("total_temperature", "static_temperature"))
 MACH_IC_MAX = 0.95
@@ -154,23 +163,12 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
     FlightDataError
         Unusable data, as for a flight CSV; the message names the export's column.
     """
-    mapping = columns if isinstance(columns, dict) else read_column_map(columns)
-    label = columns if not isinstance(columns, dict) else "the column mapping"
-    source = read_once(path)
-    name = str(source)
-    header, skip = _header(source, name)
-    index = {}
-    for key, (column, _) in mapping.items():
-        if column not in header:
-            near = difflib.get_close_matches(column, header, n=1, cutoff=0.6)
-            raise PitotcalError(f"`columns` {label}: key {key}: {name} has no column {column!r}"
-                                + (f" (found {near[0]!r})" if near else ""), param="columns")
-        index[key] = header.index(column)
-    data = _parse(source, name, skip, index)
-    flight_columns, table = _to_si(mapping, data)
     if not 0.0 < mach_ic_max <= 1.0:
         raise PitotcalError(f"`mach_ic_max` {mach_ic_max!r} must be in (0, 1]",
                             param="mach_ic_max")
+    mapping, label, name, data = _mapped_data(path, columns)
+    mapping = {k: v for k, v in mapping.items() if k not in ATTITUDE_KEYS}
+    flight_columns, table = _to_si(mapping, data)
     table, n_super, note = _subsonic(table, flight_columns, mach_ic_max)
     text = _flight_csv_text(flight_columns, table)
     where = {MAPPING_KEYS[k][0]: c for k, (c, _) in mapping.items()}
@@ -185,6 +183,49 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
         meta["alt_source"] = "gps_height"
     return dataclasses.replace(flight, meta=meta,
                                warnings=(*((note,) if note else ()), *flight.warnings))
+
+
+def read_attitude(path, columns):
+    """The attitude of a CSV export through its column mapping, for `self_survey(attitude=)`.
+
+    Returns
+    -------
+    dict of ndarray
+        `time_s` and `roll_rad`, `pitch_rad`, `heading_rad`, with `sideslip_rad` when mapped,
+        every row of the export (NaN where a cell is not a number).
+
+    Raises
+    ------
+    PitotcalError
+        A bad mapping, or one without roll, pitch and true_heading (each named).
+    """
+    mapping, label, _, data = _mapped_data(path, columns)
+    missing = [k for k in ATTITUDE_KEYS[:3] if k not in mapping]
+    if missing:
+        raise PitotcalError(f"`columns` {label}: key {missing[0]}: missing (the attitude needs "
+                            "roll, pitch and true_heading)", param="columns")
+    out = {"time_s": data["time"] * S_PER_UNIT[mapping["time"][1]]}
+    for key in ATTITUDE_KEYS:
+        if key in mapping:
+            out[MAPPING_KEYS[key][0]] = data[key] * RAD_PER_UNIT[mapping[key][1]]
+    return out
+
+
+def _mapped_data(path, columns):
+    """(mapping, its label, the export's name, {key: raw column}) of an export."""
+    mapping = columns if isinstance(columns, dict) else read_column_map(columns)
+    label = columns if not isinstance(columns, dict) else "the column mapping"
+    source = read_once(path)
+    name = str(source)
+    header, skip = _header(source, name)
+    index = {}
+    for key, (column, _) in mapping.items():
+        if column not in header:
+            near = difflib.get_close_matches(column, header, n=1, cutoff=0.6)
+            raise PitotcalError(f"`columns` {label}: key {key}: {name} has no column {column!r}"
+                                + (f" (found {near[0]!r})" if near else ""), param="columns")
+        index[key] = header.index(column)
+    return mapping, label, name, _parse(source, name, skip, index)
 
 
 def _header(source, name):
@@ -203,7 +244,8 @@ def _parse(source, name, skip, index):
     with io.TextIOWrapper(open_binary(source), encoding="utf-8-sig", errors="replace") as f:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            data = np.genfromtxt(f, delimiter=",", skip_header=skip, usecols=[index[k] for k in keys],
+            data = np.genfromtxt(f, delimiter=",", skip_header=skip,
+                                 usecols=[index[k] for k in keys],
                                  dtype=float, invalid_raise=False, comments="#")
     data = np.atleast_2d(data).reshape(-1, len(keys))
     if data.shape[0] == 0:
