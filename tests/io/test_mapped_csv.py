@@ -147,3 +147,20 @@ def test_attitude_needs_roll_pitch_and_heading(export, tmp_path):
     flight = read_flight(path, columns=full)          # angles are not flight columns
     assert got["roll_rad"] == pytest.approx(np.radians(flight.gps_vn_mps / FT_TO_M), rel=1e-9)
     assert got["time_s"] == pytest.approx(flight.time_s) and "sideslip_rad" not in got
+
+
+def test_a_bad_row_is_named_as_the_export_numbers_it(export, tmp_path):
+    """Rows left out above M_ic 0.95 do not shift the row a message names."""
+    path, mapping, _, _ = export
+    lines = path.read_text().splitlines()
+    header, rows = lines[0], [line.split(",") for line in lines[1:]]
+    pt = header.split(",").index("pt_psi")
+    for r in rows[:30]:
+        r[pt] = "30"                      # p_t 30 psi over p_s ~ 11 psi: M_ic above 1
+    for r in rows[40:100]:
+        r[pt] = "nan"
+    bad = tmp_path / "bad.csv"
+    bad.write_text("\n".join([header, *(",".join(r) for r in rows)]) + "\n")
+    with pytest.raises(PitotcalError, match=r"column qc_pa, row 41 \(line 42\): NaN .*"
+                                            r"\[qc_pa is pt_psi - ps_hpa via "):
+        read_flight(bad, columns=mapping)

@@ -28,6 +28,7 @@ static source reads 4 % of p_s high (a jet's transonic static error; M_ic 0.98 i
 import dataclasses
 import difflib
 import io
+import re
 import tomllib
 import warnings
 
@@ -166,10 +167,11 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
     if not 0.0 < mach_ic_max <= 1.0:
         raise PitotcalError(f"`mach_ic_max` {mach_ic_max!r} must be in (0, 1]",
                             param="mach_ic_max")
-    mapping, label, name, data = _mapped_data(path, columns)
+    mapping, label, name, data, header_line = _mapped_data(path, columns)
     mapping = {k: v for k, v in mapping.items() if k not in ATTITUDE_KEYS}
     flight_columns, table = _to_si(mapping, data)
-    table, n_super, note = _subsonic(table, flight_columns, mach_ic_max)
+    kept, n_super, note = _subsonic(table, flight_columns, mach_ic_max)
+    table = table[kept]
     text = _flight_csv_text(flight_columns, table)
     where = {MAPPING_KEYS[k][0]: c for k, (c, _) in mapping.items()}
     where["qc_pa"] = where.get("qc_pa") or f"{where['pt_pa']} - {where['ps_pa']}"
@@ -177,7 +179,8 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
         flight = read_flight_csv(InputBytes(name, text), start_s, end_s,
                                  temp_recovery=temp_recovery, rh_pct=rh_pct)
     except FlightDataError as exc:
-        raise FlightDataError(f"{exc} [{_named(str(exc), where)} via {label}]") from None
+        message = _export_rows(str(exc), np.flatnonzero(kept), header_line)
+        raise FlightDataError(f"{message} [{_named(message, where)} via {label}]") from None
     meta = {**flight.meta, "columns": str(label), "excluded_supersonic": n_super}
     if "gps_height" in mapping:
         meta["alt_source"] = "gps_height"
@@ -199,7 +202,7 @@ def read_attitude(path, columns):
     PitotcalError
         A bad mapping, or one without roll, pitch and true_heading (each named).
     """
-    mapping, label, _, data = _mapped_data(path, columns)
+    mapping, label, _, data, _ = _mapped_data(path, columns)
     missing = [k for k in ATTITUDE_KEYS[:3] if k not in mapping]
     if missing:
         raise PitotcalError(f"`columns` {label}: key {missing[0]}: missing (the attitude needs "
@@ -212,7 +215,7 @@ def read_attitude(path, columns):
 
 
 def _mapped_data(path, columns):
-    """(mapping, its label, the export's name, {key: raw column}) of an export."""
+    """(mapping, its label, the export's name, {key: raw column}, the header's line number)."""
     mapping = columns if isinstance(columns, dict) else read_column_map(columns)
     label = columns if not isinstance(columns, dict) else "the column mapping"
     source = read_once(path)
@@ -225,7 +228,7 @@ def _mapped_data(path, columns):
             raise PitotcalError(f"`columns` {label}: key {key}: {name} has no column {column!r}"
                                 + (f" (found {near[0]!r})" if near else ""), param="columns")
         index[key] = header.index(column)
-    return mapping, label, name, _parse(source, name, skip, index)
+    return mapping, label, name, _parse(source, name, skip, index), skip
 
 
 def _header(source, name):
@@ -270,21 +273,31 @@ def _to_si(mapping, data):
 
 
 def _subsonic(table, names, mach_ic_max):
-    """Rows at or below `mach_ic_max` by q_ci/p_s (and rows where it is not a number), the
-    count left out and the warning saying so."""
+    """Which rows are at or below `mach_ic_max` by q_ci/p_s (or not a number there), the count
+    left out and the warning saying so."""
     ratio = table[:, names.index("qc_pa")] / table[:, names.index("ps_pa")]
     above = ratio > float(qc_from_mach_pa(mach_ic_max, 1.0))
     n = int(np.count_nonzero(above))
     note = f"{n} samples {SUPERSONIC_NOTE.format(mach_ic_max)}" if n else None
     if note:
         warnings.warn(note, stacklevel=3)
-    return table[~above], n, note
+    return ~above, n, note
 
 
 def _flight_csv_text(names, table):
     buf = io.StringIO()
     np.savetxt(buf, table, delimiter=",", header=",".join(names), comments="", fmt="%.10g")
     return buf.getvalue().encode()
+
+
+def _export_rows(message, kept, header_line):
+    """`message` with each 'row R (line L)' of the converted table as the export's own row and
+    line (rows left out above M_ic counted; the line assumes no blank lines among the data)."""
+    def export(match):
+        row = int(kept[int(match.group(1)) - 1]) + 1 if int(match.group(1)) <= kept.size \
+            else int(match.group(1))
+        return f"row {row} (line {header_line + row})"
+    return re.sub(r"row (\d+) \(line \d+\)", export, message)
 
 
 def _named(message, where):
