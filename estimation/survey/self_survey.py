@@ -17,10 +17,11 @@ W (north, east) and r; every sample then gives its own static position error
 
     Δp_p / p_s = (p_s − p(h)) / p_s    against    M_ic = M(p_t − p_s, p_s),
 
-(with the attitude and the sideslip vane given, the airspeed is compared as a vector,
-V_t u + W = V_g, u its direction from `airspeed_direction`, and the vertical wind is fitted too)
 with no model of how Δp_p depends on M_ic: the curve is whatever the data say, through the
-transonic region. Samples with M_ic above `MACH_IC_FIT_MAX` enter the curve but not the fit
+transonic region. With the attitude and the sideslip vane given, the airspeed is compared as a
+vector, V_t u + W = V_g (u its direction, `airspeed_direction`), and the vertical wind is
+fitted too. The profile's T̄ is the probe's temperature with r = 1 at M_ic: over the few tens
+of metres of a level test point its error moves p(h) by far less than its stated bound. Samples with M_ic above `MACH_IC_FIT_MAX` enter the curve but not the fit
 (their true Mach number may pass 1, where the subsonic pitot relation of the fit does not
 hold); samples above M_ic 1 are left out until the supersonic relation is in.
 
