@@ -42,12 +42,10 @@ from .gps_velocity import estimate_gps_noise_std, interpolate_held
 from .models import qci_from_qc_pa
 from .scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from .units import (
-    ISA_EXPONENT,
-    ISA_P0_PA,
-    ISA_T0_K,
     R_AIR_JKGK,
     isa_density_kgm3,
     isa_pressure_pa,
+    isa_state_of_density,
     isa_temperature_k,
 )
 
@@ -259,7 +257,8 @@ def isa_air(alt_m, air_data=DEFAULT_AIR_DATA, oat_k=None):
 
 def isa_air_of_density(rho_kgm3, air_data=DEFAULT_AIR_DATA):
     """The ISA air of density ρ (kg/m³): `IncompressibleAir` (ρ) or `StaticAir` at the ISA
-    troposphere state of that density, T = T₀ (ρ/ρ₀)^(1/(n − 1)), p = ρ R T, n = g₀/(R L).
+    state of that density (`pitotcal.core.units.isa_state_of_density`: in the troposphere
+    T = T₀ (ρ/ρ₀)^(1/(n − 1)), p = ρ R T, n = g₀/(R L); the layers above to 32 km likewise).
 
     For callers that carry only a density (the design's schedules): the compressible relation
     then needs the pressure and temperature that go with it.
@@ -267,9 +266,7 @@ def isa_air_of_density(rho_kgm3, air_data=DEFAULT_AIR_DATA):
     rho = np.asarray(rho_kgm3, float)
     if air_data == "incompressible":
         return IncompressibleAir(rho)
-    rho0 = ISA_P0_PA / (R_AIR_JKGK * ISA_T0_K)
-    oat = ISA_T0_K * (rho / rho0) ** (1.0 / (ISA_EXPONENT - 1.0))
-    return StaticAir(rho * R_AIR_JKGK * oat, oat)
+    return StaticAir(*isa_state_of_density(rho))
 
 
 @dataclass(frozen=True)
