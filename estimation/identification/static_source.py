@@ -34,7 +34,8 @@ from pitotcal.core.models import get_model, qc_from_qci_pa
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import kt_to_mps, m_to_ft
 
-__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "fitted_static_error",
+__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "calibrated_mach",
+           "fitted_static_error",
            "plot_altimeter_correction",
            "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",
            "static_source_products", "static_statement", "static_table_lines",
@@ -79,6 +80,25 @@ def _on(ok, fun, *args):
         out[ok] = fun(*(np.broadcast_to(np.asarray(a, dtype=float), ok.shape)[ok]
                         for a in args))
     return out
+
+
+def calibrated_mach(result, flight):
+    """The true Mach of each sample of `flight` by the calibration `result`, ndarray (N,).
+
+    q_c = q_ci / (1 − f(q_ci; k)) and p_s = p_s,ind − (q_c − q_ci) (all the error in the static
+    source), or the reference static pressure when the result used one; the indicated Mach
+    (q_ci / p_s,ind) where the calibration gives none.
+    """
+    qci = np.asarray(flight.qci_pa, dtype=float)
+    ps_ind = np.asarray(flight.ps_pa, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        qc = qc_from_qci_pa(get_model(result.model), result.coefficients, qci)
+    ps = (np.asarray(flight.ps_ref_pa, dtype=float)
+          if result.ps_ref_pa is not None and flight.ps_ref_pa is not None
+          else ps_ind - (qc - qci))
+    mach = _on(_in_mach_range(qc, ps), airdata.mach_from_qc, qc, ps)
+    indicated = _on(_in_mach_range(qci, ps_ind), airdata.mach_from_qc, qci, ps_ind)
+    return np.where(np.isfinite(mach), mach, np.nan_to_num(indicated))
 
 
 def static_error_fit(result):
@@ -236,7 +256,8 @@ def static_statement(result):
 def air_data_lines(result):
     """The compressible summary's statement of what was computed and assumed."""
     return [
-        ("Air data: compressible (isentropic q_c from V_t, the static port's p_s and T_s); "
+        ("Air data: compressible (isentropic q_c from V_t, Rayleigh pitot above Mach 1; the "
+         "static port's p_s and T_s); "
          "KIAS = V_ic and KCAS = V_c by the standard CAS law, ΔV = ΔV_pc."),
         (f"{'Assumed' if result.ps_ref_pa is None else 'Measured'}: "
          f"{static_statement(result)[0]}."),

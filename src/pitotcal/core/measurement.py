@@ -54,12 +54,14 @@ __all__ = [
     "AIR_DATA_MODES",
     "Channels",
     "DEFAULT_AIR_DATA",
+    "INCOMPRESSIBLE_MACH_MAX",
     "IncompressibleAir",
     "StaticAir",
     "TotalPressureAir",
     "as_air",
     "flight_air",
     "flight_channels",
+    "flight_mach",
     "impact_pressure_pa",
     "isa_air",
     "isa_air_of_density",
@@ -69,6 +71,10 @@ __all__ = [
     "sensitivities",
     "tas_squared",
 ]
+
+# Above this Mach number the incompressible relation q_c = ½ρV_t² is short of the impact
+# pressure by more than M²/4 = 2.25 %: an incompressible fit is then warned about.
+INCOMPRESSIBLE_MACH_MAX = 0.3
 
 # The flight's data channels of each air-data type (`flight_air`), by the estimator's mode:
 # "reference" is the compressible fit from an independent reference static pressure.
@@ -241,6 +247,22 @@ def flight_air(flight, air_data=DEFAULT_AIR_DATA):
     if air_data == "compressible":
         return TotalPressureAir(np.asarray(flight.ps_pa, float) + flight.qci_pa, oat)
     return StaticAir(np.asarray(flight.ps_ref_pa, float), oat)
+
+
+def flight_mach(flight, wind_n_mps, wind_e_mps):
+    """The true Mach number of each sample of `flight`, ndarray (N,).
+
+    V_t from the GPS ground velocity less the air-mass velocity (`tas_squared`, the vertical
+    speed included when logged); the speed of sound from the flight's `oat_k`, or without it
+    from the ISA temperature of its density (`isa_state_of_density`). NaN where the
+    temperature is not positive.
+    """
+    vd_sq = None if flight.gps_vd_mps is None else np.asarray(flight.gps_vd_mps, float) ** 2
+    tas_sq = tas_squared(np.asarray(flight.gps_vn_mps, float), np.asarray(flight.gps_ve_mps, float),
+                         wind_n_mps, wind_e_mps, vd_sq)
+    oat = flight.oat_k if flight.oat_k is not None else isa_state_of_density(flight.rho_kgm3)[1]
+    with np.errstate(invalid="ignore", divide="ignore"):     # a bad cell gives NaN there
+        return np.sqrt(tas_sq) / airdata.speed_of_sound_mps(np.asarray(oat, float))
 
 
 def isa_air(alt_m, air_data=DEFAULT_AIR_DATA, oat_k=None):

@@ -143,4 +143,6 @@ def test_compressible_graph_size_does_not_grow_with_n():
     model = get_model("inverse")
     small, large = (objective_function(model, n, False, "compressible").n_nodes()
                     for n in (10, 1_000_000))
-    assert small == large < 80
+    # 125 nodes since the pitot relation has its Rayleigh branch above Mach 1 (if_else: both
+    # branches are evaluated); under 80 when it was isentropic only
+    assert small == large < 140
