@@ -32,7 +32,7 @@ import numpy as np
 from .airdata import QC_OVER_PS_MAX, mach_from_qc, pressure_altitude_m
 from .checks import number
 from .errors import FlightDataError, PitotcalError
-from .units import R_AIR_JKGK
+from .units import R_AIR_JKGK, isa_temperature_k
 
 __all__ = [
     "EPSILON",
@@ -136,9 +136,9 @@ def ram_rise_note(flight):
     """The warning of a static `oat_k` column that rises with airspeed as a total temperature
     does, or None.
 
-    Regresses oat_k on the ram rise 0.2 M_i² T (M_i from q_ci / p_s) and the pressure altitude
-    (the lapse rate): a static temperature has no ram-rise term, a total one a slope near the
-    probe's recovery factor (about 1). Needs `ps_pa` and a ram rise that spans _RAM_SPAN_K
+    Regresses oat_k, less the ISA lapse over the flight's pressure altitudes, on the ram rise
+    0.2 M_i² T (M_i from q_ci / p_s): a static temperature has no ram-rise term, a total one
+    a slope near the probe's recovery factor (about 1). Needs `ps_pa` and a ram rise that spans _RAM_SPAN_K
     over the flight, so at low speed it says nothing.
     """
     if flight.oat_k is None or flight.ps_pa is None or flight.n < 10:
@@ -152,10 +152,12 @@ def ram_rise_note(flight):
     rise = 0.2 * mach_from_qc(ratio[ok] * ps[ok], ps[ok]) ** 2 * t[ok]
     if np.ptp(np.percentile(rise, [2, 98])) < _RAM_SPAN_K:
         return None
-    with np.errstate(invalid="ignore"):
-        alt = pressure_altitude_m(np.clip(ps[ok], 870.0, 1.08e5))
-    design = np.column_stack([np.ones(rise.size), rise, alt - alt.mean()])
-    slope = float(np.linalg.lstsq(design, t[ok], rcond=None)[0][1])
+    # the standard lapse rate taken out, not fitted: the static port's position error moves
+    # the indicated altitude with the speed, so a fitted altitude term would take the ram rise
+    alt = pressure_altitude_m(np.clip(ps[ok], 870.0, 1.08e5))
+    level = t[ok] - (isa_temperature_k(alt) - isa_temperature_k(np.median(alt)))
+    design = np.column_stack([np.ones(rise.size), rise])
+    slope = float(np.linalg.lstsq(design, level, rcond=None)[0][1])
     if slope < _RAM_FRACTION:
         return None
     return (f"{flight.source}: column oat_k rises with airspeed as a total temperature does "
