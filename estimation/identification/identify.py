@@ -221,8 +221,7 @@ def _incompressible_note(result, flight):
             f"Mach {mach:.2f}: above Mach {INCOMPRESSIBLE_MACH_MAX:g} the impact pressure "
             f"exceeds ½ρV_t² by about M²/4 ({25 * mach ** 2:.1f} % at Mach {mach:.2f}), "
             "which the fit takes into the pressure-error coefficients and ΔV; fit with the "
-            "compressible air data (`air`=\"compressible\", --air compressible; needs ps_pa "
-            "and oat_k)")
+            "compressible air data (`air` \"compressible\"; it needs ps_pa and oat_k)")
 
 
 def _with_warning(result, note):

@@ -102,7 +102,8 @@ class PlanRequest:
         Radius of the test area around its centre; the ground track stays inside it at every
         node in the given wind.
     altitude_m : float
-        Constant plan altitude, -400 to 11,000 m (ISA density there gives TAS from CAS).
+        Constant plan altitude, -400 to 32,000 m (`ALTITUDE_RANGE_M`; the ISA there gives
+        TAS from CAS).
     duration_s, bank_max_deg : float
         Maneuver length, s (at most MAX_DURATION_S); bank limit, degrees (0-75).
     wind_speed_mps, wind_from_deg : float

@@ -164,7 +164,8 @@ def ram_rise_note(flight):
             f"(it follows {slope:.2f} of the ram rise 0.2 M² T, which reaches "
             f"{np.percentile(rise, 98):.1f} K at the top speeds; a static temperature does "
             "not rise): if it is the probe's total temperature, give it as column tat_k "
-            "(with --temp-recovery), or the static temperature is too warm by that much")
+            "(with its recovery factor, `temp_recovery`), or the static temperature is too "
+            "warm by that much")
 
 
 def check_air_options(temp_recovery=1.0, rh_pct=None):
