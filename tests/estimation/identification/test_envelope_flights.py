@@ -115,3 +115,17 @@ def test_incompressible_fit_is_warned_about(flown):
     rho_only = dataclasses.replace(flight, ps_pa=None, oat_k=None)
     assert any("fitted with the incompressible air data" in w
                for w in identify(rho_only, model="inverse").warnings)
+
+
+def test_a_flight_at_25_km_is_not_gated_away():
+    """The density gate compares with the ISA at the flight's altitude up to 32 km (it stopped
+    at 20 km: every sample of this flight was dropped as implausible)."""
+    plan = circle_plan(duration_s=300.0, cas_kt=(120.0, 160.0), radius_m=20000.0,
+                       altitude_m=25000.0, wind_speed_mps=10.0, step_s=1.0)
+    flight, truth = simulate(plan, seed=0, turbulence_mps=0.0, rate_hz=10.0,
+                             air_data="compressible")
+    result = identify(flight, model="inverse")
+    assert result.success and result.n_samples == flight.n
+    for key in ("k1", "k2", "wind_speed_mps", "wind_from_deg"):
+        z = (result.value(key) - truth.parameters[key]) / result.stddev(key)
+        assert abs(z) < 3.0, (key, z)
