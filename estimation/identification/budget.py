@@ -34,6 +34,11 @@ The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a coun
 - qc_scale, qc_offset: the transducer's calibration, u = 0.1 % of reading and 1 Pa (a
   calibrated flight-test transducer; a hobby MEMS sensor is 1 % and 5-10 Pa): ΔV_pc is the
   position error only if the transducer's own error is known to this.
+
+A compressible result's static-source products, the altimeter correction ΔH_pc (ft) and the
+Mach correction ΔM_pc, get the same budget from the same re-solves: each perturbed calibration
+is carried to ΔH and ΔM at the table's speeds (`static_source.static_source_products`) and
+differenced as ΔV is, and the statistical part is their own 2σ / 2 (`Budget.products`).
 """
 
 import dataclasses
@@ -115,6 +120,9 @@ class Budget:
     inputs : dict
         Source name -> (standard uncertainty of the input, unit).
     warnings : tuple of str
+    products : dict
+        Static-source product ("dh_ft", "dmach") -> {"statistical": σ at each speed, source
+        name -> u_j at each speed}, in the product's unit; empty for an incompressible result.
     """
 
     vi_kt: np.ndarray
@@ -122,6 +130,7 @@ class Budget:
     terms_kt: dict
     inputs: dict
     warnings: tuple = ()
+    products: dict = dataclasses.field(default_factory=dict)
 
     @property
     def combined_kt(self):
@@ -133,6 +142,21 @@ class Budget:
     def expanded_kt(self):
         """U = k u_c, k = 2, at each speed, kt."""
         return COVERAGE_K * self.combined_kt
+
+    def product_expanded(self, name):
+        """U = k u_c of a static-source product (`products`) at each speed."""
+        terms = self.products[name]
+        return COVERAGE_K * np.sqrt(sum(t ** 2 for t in terms.values()))
+
+    def product_row(self, i):
+        """The correction row's static-source budget keys at speed index `i`: dh_U_ft,
+        u_dh_by_source_ft, dmach_U, u_dmach_by_source (empty without `products`)."""
+        out = {}
+        for key, (u_key, by_key) in _PRODUCT_KEYS.items():
+            if key in self.products:
+                out[u_key] = float(self.product_expanded(key)[i])
+                out[by_key] = {n: float(u[i]) for n, u in self.products[key].items()}
+        return out
 
     def to_list(self):
         """The JSON's `uncertainty_budget`: statistical first, each u_dv_kt its max over V_i."""
@@ -185,23 +209,30 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     notes = []
 
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
+    prod0 = _static_products(result, vi)
+    moved = {key: {} for key in prod0}
 
     def sensitivity(perturb, name):
         """u at each speed: the RMS of the re-solves' changes at +u and -u; NaN (and a note
         naming the source) where a re-solve is refused or its ΔV does not exist."""
-        dv = []
+        dv, prods = [], []
         for sign in (1.0, -1.0):
             try:
                 res = estimate(perturb(sign), **kwargs)
             except PitotcalError as exc:
                 notes.append(f"uncertainty budget: the {name} term is not computed: its "
                              f"perturbed re-solve was refused ({exc})")
+                for key in prod0:
+                    moved[key][name] = np.full_like(vi, np.nan)
                 return np.full_like(vi, np.nan)
             if not res.success:
                 notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
                              f"({res.message})")
             dv.append(delta_v_kt_where_defined(get_model(res.model), res.coefficients, vi,
                                                res.air_data) - dv0)
+            prods.append(_static_products(res, vi) if prod0 else {})
+        for key in prod0:
+            moved[key][name] = _rms_change(prods, key, prod0[key])
         u = np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
         if not np.all(np.isfinite(u)):
             notes.append(f"uncertainty budget: the {name} term is not computed at "
@@ -225,10 +256,41 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
             terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u), name)
     for note in notes:
         warnings.warn(note, stacklevel=2)
+    # in the terms' order; a term with no re-solve (a zero input) moves nothing
+    products = {key: {"statistical": np.array([r.get(band, np.nan) for r in rows],
+                                              dtype=float) / 2.0,
+                      **{n: moved[key].get(n, np.zeros_like(vi)) for n in terms}}
+                for key, band in _PRODUCT_BANDS.items() if key in prod0}
     return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,
                   inputs={name: (abs(getattr(inputs, field)), unit)
                           for name, field, unit in SOURCES},
-                  warnings=tuple(dict.fromkeys(notes)))
+                  warnings=tuple(dict.fromkeys(notes)), products=products)
+
+
+# static-source product -> the JSON row's keys of its U and of its terms
+_PRODUCT_KEYS = {"dh_ft": ("dh_U_ft", "u_dh_by_source_ft"),
+                 "dmach": ("dmach_U", "u_dmach_by_source")}
+# static-source product -> the correction table's 2σ column of it
+_PRODUCT_BANDS = {"dh_ft": "dh_2sigma_ft", "dmach": "dmach_2sigma"}
+
+
+def _static_products(result, vi):
+    """{"dh_ft", "dmach"} of a compressible result at the speeds `vi`; {} otherwise."""
+    from .static_source import static_source_products
+
+    if result.air_data != "compressible" or result.ps_pa is None:
+        return {}
+    grid = static_source_products(result, vi)
+    return {key: np.asarray(grid[key], dtype=float) for key in ("dh_ft", "dmach")}
+
+
+def _rms_change(perturbed, key, base):
+    """sqrt((d₊² + d₋²) / 2) of a product's change in the two re-solves (NaN where one has
+    none: a re-solve refused or a product undefined)."""
+    if len(perturbed) < 2 or key not in perturbed[0] or key not in perturbed[1]:
+        return np.full_like(base, np.nan)
+    d = [p[key] - base for p in perturbed]
+    return np.sqrt((d[0] ** 2 + d[1] ** 2) / 2.0)
 
 
 # --- perturbed flights (Flight, result, signed step) -> Flight --------------------------------
