@@ -193,7 +193,16 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     vertical channel): at most 14, each reusing `identify`'s cached solver
     (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
     identify's estimate without the bounds and consistency checks the budget does not use.
+    A compressible result's ΔH_pc and ΔM_pc get their budget from the same re-solves
+    (`Budget.products`).
     """
+    solved = {}                         # source -> its two re-solves, for ΔH and ΔM
+    budget = _resolved_budget(flight, result, inputs, identify_kwargs, solved)
+    return dataclasses.replace(budget, products=_products_budget(result, budget, solved))
+
+
+def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
+    """The airspeed budget of `uncertainty_budget`; each source's re-solves go to `solved`."""
     from .fit import estimate
 
     inputs = (inputs or BudgetInputs()).checked()
@@ -209,30 +218,24 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     notes = []
 
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
-    prod0 = _static_products(result, vi)
-    moved = {key: {} for key in prod0}
 
     def sensitivity(perturb, name):
         """u at each speed: the RMS of the re-solves' changes at +u and -u; NaN (and a note
         naming the source) where a re-solve is refused or its ΔV does not exist."""
-        dv, prods = [], []
+        dv = []
         for sign in (1.0, -1.0):
             try:
                 res = estimate(perturb(sign), **kwargs)
             except PitotcalError as exc:
                 notes.append(f"uncertainty budget: the {name} term is not computed: its "
                              f"perturbed re-solve was refused ({exc})")
-                for key in prod0:
-                    moved[key][name] = np.full_like(vi, np.nan)
                 return np.full_like(vi, np.nan)
             if not res.success:
                 notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
                              f"({res.message})")
             dv.append(delta_v_kt_where_defined(get_model(res.model), res.coefficients, vi,
                                                res.air_data) - dv0)
-            prods.append(_static_products(res, vi) if prod0 else {})
-        for key in prod0:
-            moved[key][name] = _rms_change(prods, key, prod0[key])
+            solved.setdefault(name, []).append(res)
         u = np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
         if not np.all(np.isfinite(u)):
             notes.append(f"uncertainty budget: the {name} term is not computed at "
@@ -256,15 +259,10 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
             terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u), name)
     for note in notes:
         warnings.warn(note, stacklevel=2)
-    # in the terms' order; a term with no re-solve (a zero input) moves nothing
-    products = {key: {"statistical": np.array([r.get(band, np.nan) for r in rows],
-                                              dtype=float) / 2.0,
-                      **{n: moved[key].get(n, np.zeros_like(vi)) for n in terms}}
-                for key, band in _PRODUCT_BANDS.items() if key in prod0}
     return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,
                   inputs={name: (abs(getattr(inputs, field)), unit)
                           for name, field, unit in SOURCES},
-                  warnings=tuple(dict.fromkeys(notes)), products=products)
+                  warnings=tuple(dict.fromkeys(notes)))
 
 
 # static-source product -> the JSON row's keys of its U and of its terms
@@ -272,6 +270,28 @@ _PRODUCT_KEYS = {"dh_ft": ("dh_U_ft", "u_dh_by_source_ft"),
                  "dmach": ("dmach_U", "u_dmach_by_source")}
 # static-source product -> the correction table's 2σ column of it
 _PRODUCT_BANDS = {"dh_ft": "dh_2sigma_ft", "dmach": "dmach_2sigma"}
+
+
+def _products_budget(result, budget, solved):
+    """`Budget.products`: each product's statistical part (its 2σ / 2) and, per term in the
+    budget's order, the RMS change of its two re-solves; a term without them has the ΔV
+    term's zeros (no input) or NaN (refused)."""
+    from .static_source import static_source_products
+
+    vi = budget.vi_kt
+    if result.air_data != "compressible" or result.ps_pa is None:
+        return {}
+    grid = static_source_products(result, vi)
+    out = {}
+    for key, band in _PRODUCT_BANDS.items():
+        terms = {"statistical": np.asarray(grid[band], dtype=float) / 2.0}
+        for name, u_dv in budget.terms_kt.items():
+            pair = solved.get(name, [])
+            terms[name] = (_rms_change([_static_products(r, vi) for r in pair], key,
+                                       np.asarray(grid[key], dtype=float))
+                           if len(pair) == 2 else u_dv * 0.0)
+        out[key] = terms
+    return out
 
 
 def _static_products(result, vi):

@@ -172,7 +172,7 @@ def _window(regulation, check, configuration, speeds, speed_range_kt, flown):
     if speed_range_kt is None:
         return regs.speed_window(regulation, check, configuration, speeds, flown)
     lo, hi = _speed_range(speed_range_kt)
-    return {"lo_kt": lo, "hi_kt": hi, "source": "given", "text": "as given (--speed-range-kt)"}
+    return {"lo_kt": lo, "hi_kt": hi, "source": "given", "text": "as given (speed_range_kt)"}
 
 
 def _speed_range(speed_range_kt):
