@@ -76,3 +76,20 @@ def test_expanded_uncertainty_carries_the_type_b_terms(flown):
         assert r["verdict"] == expected
     assert top["verdict"] == "not demonstrated"
     assert np.isfinite(row["dmach_U"]) and row["dmach_U"] > 0
+
+
+def test_sitl_log_low_speeds_comply_under_the_30_ft_floor(shared_file, tmp_path):
+    """The ArduPlane SITL log with --oat-c 15 (185 ft): ΔH 17-26 ft at 46-57 KCAS was judged
+    against 14-17 ft (0.3 ft/kt) and did not comply; the paragraph's floor is 30 ft."""
+    import json
+
+    from pitotcal.cli import main
+
+    log = shared_file("ardupilot/arduplane_sitl.log")
+    out = tmp_path / "sitl.json"
+    assert main(["identify", str(log), "--oat-c", "15", "--no-budget", "--json", str(out)]) == 0
+    block = assess(json.loads(out.read_text()), "23.1323")
+    rows = [r for r in block["altimeter"]["rows"] if 46.0 <= r["vc_kt"] <= 58.0]
+    assert len(rows) >= 5 and min(r["dh_ft"] for r in rows) > 16.0
+    assert max(r["dh_ft"] for r in rows) > 25.0
+    assert all(r["limit_ft"] == 30.0 and r["verdict"] == "complies" for r in rows)
