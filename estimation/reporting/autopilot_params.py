@@ -59,9 +59,10 @@ from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
 from .compliance import REGULATIONS
 
-__all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "MISFIT_TOLERANCE_KT", "TOLERANCE",
-           "ParameterRecommendation", "ParameterRefused", "misfit_text", "px4_sensor_note",
-           "recommend", "write_parameter_file"]
+__all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "MISFIT_TOLERANCE_KT",
+           "MISFIT_TOLERANCE_MAX_KT", "TOLERANCE", "ParameterRecommendation", "ParameterRefused",
+           "check_misfit_tolerance", "misfit_text", "px4_sensor_note", "recommend",
+           "write_parameter_file"]
 
 # A parameter is committed only after turning through three quarters of a circle: wind and
 # scale then separate with margin (identify itself needs only more than half a circle).
@@ -75,6 +76,8 @@ PARAMETER = {"ArduPilot": ARDUPILOT_RATIO, "PX4": PX4_SCALES[0]}
 # airspeed limit (5 kt), so that a single scale leaves two thirds of the limit to the rest of
 # the position error and the calibration's own uncertainty
 MISFIT_TOLERANCE_KT = REGULATIONS["23.1323"]["floor_kt"] / 3.0
+# ... and the largest tolerance that still means one: beyond it any single value would pass
+MISFIT_TOLERANCE_MAX_KT = 50.0
 # Grid of the structure misfit, kt: fine enough that the largest departure between the flown
 # ends is not missed (the correction table's coarser grid keeps the refusal rule unchanged)
 MISFIT_STEP_KT = 1.0
@@ -195,7 +198,7 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
                             "must come from an ArduPilot or PX4 log (or its converted CSV)")
     name = name or PARAMETER[autopilot]
     tolerance = (MISFIT_TOLERANCE_KT if misfit_tolerance_kt is None else
-                 number("misfit_tolerance_kt", misfit_tolerance_kt, 0.0, lo_open=True))
+                 check_misfit_tolerance(misfit_tolerance_kt))
     spread = track_spread_deg(flight.gps_vn_mps, flight.gps_ve_mps)
     if spread < MIN_TRACK_SPREAD_DEG:
         raise PitotcalError(f"no parameter recommended: the track turned through only "
@@ -261,6 +264,12 @@ def _sdp3x_ias(dp_pa, ps_pa, rho_kgm3, tube_m, pitot):
     dp_pitot = (0.0032 * flow ** 2 + 0.0123 * flow + 1.0) * 1.29 / rho_kgm3 if pitot else 0.0
     dp_tube = flow * 0.674 / 450.0 * tube_m * rho_kgm3 / 1.29
     return np.sqrt(2.0 * (dp_corr + dp_tube + dp_pitot) / RHO0_KGM3) + 0.125 * flow
+
+
+def check_misfit_tolerance(misfit_tolerance_kt):
+    """`misfit_tolerance_kt` checked: above 0, at most `MISFIT_TOLERANCE_MAX_KT` kt."""
+    return number("misfit_tolerance_kt", misfit_tolerance_kt, 0.0, MISFIT_TOLERANCE_MAX_KT,
+                  lo_open=True)
 
 
 def _judge_misfit(name, misfit, departures, tolerance):

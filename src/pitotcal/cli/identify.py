@@ -178,6 +178,10 @@ def run(args):
     # the live options are checked with a file too: a NaN is no option anywhere
     idle_timeout_s(args.idle_s)
     positive("target_2sigma_kt", args.target_2sigma_kt)
+    if args.misfit_tolerance_kt is not None:
+        from pitotcal.estimation.reporting.autopilot_params import check_misfit_tolerance
+
+        check_misfit_tolerance(args.misfit_tolerance_kt)
     if args.live is not None or args.flight is None:
         return _run_live(args)
     import warnings
