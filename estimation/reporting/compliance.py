@@ -192,7 +192,8 @@ def _quotes(regulation):
         for para in paragraphs:
             words, extent, source = regs.QUOTES[para]
             out.append({"check": check, "paragraph": f"14 CFR {para}", "text": words,
-                        "extent": extent, "source": source})
+                        "extent": extent, "source": source,
+                        "note": regs.QUOTE_NOTES.get(para)})
     return out
 
 

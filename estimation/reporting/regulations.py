@@ -6,8 +6,9 @@ quotation is marked as an excerpt, and what was not read is said in words of our
 in quotation marks. The altimeter paragraphs' "at sea level, with a standard atmosphere" and
 "need not be less than ±30 feet" were read in 14 CFR 29.1325(f), whose words the fixed-wing
 paragraphs 23.1325(e) (to Amdt. 23-63) and 25.1325(e) share; their speed windows (1.3 V_S0 to
-1.8 V_S1, and 1.23 V_SR0 to 1.7 V_SR1) are applied from the paragraphs as the lead engineer's
-brief gives them and are flagged in the report as not read here.
+1.8 V_S1, and 1.23 V_SR0 to 1.7 V_SR1) and those of 23.1323(b) are applied as these paragraphs
+are commonly cited, and the window's text in the report says that they were not read here
+(25.1323(c)'s were).
 
 Part 23 since Amdt. 23-64 (2017) and CS-23 since Amdt. 5 are performance-based: the accepted
 means of compliance for these limits is the consensus standard ASTM F3233 (instrumentation),
@@ -61,6 +62,12 @@ QUOTES = {
         "full", _ECFR_29_1325),
 }
 
+# why a paragraph of another Part is quoted
+QUOTE_NOTES = {
+    "29.1325(f)": ("read in the rotorcraft paragraph: the full text of the fixed-wing altimeter "
+                   "paragraph was not available here; its sea-level, standard-atmosphere basis "
+                   "and ±30 ft floor are applied in these words"),
+}
 # regulation -> the paragraphs quoted beside the airspeed and the altimeter numbers
 QUOTED_FOR = {
     "23.1323": {"airspeed": ("23.1323(b)",), "altimeter": ("23.1325(e)", "29.1325(f)")},
@@ -132,6 +139,8 @@ def speed_window(regulation, check, configuration, speeds_kcas, flown):
                 "text": f"{regulation}(c) has no speed range for the {configuration} "
                         "configuration: not judged"}
     (f_lo, s_lo), highs, words = ends
+    if not words.endswith("25.1323(c)(1)") and not words.endswith("25.1323(c)(2)"):
+        words += " (this range as the paragraph is cited; its text not read here)"
     lo = f_lo * speeds_kcas[s_lo] if s_lo in speeds_kcas else None
     hi = next((f * speeds_kcas[s] for f, s in highs if s in speeds_kcas), None)
     missing = [s for s, v in ((s_lo, lo), ("/".join(s for _, s in highs), hi)) if v is None]
