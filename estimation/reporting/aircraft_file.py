@@ -15,6 +15,8 @@ import tomllib
 
 from pitotcal.core.errors import PitotcalError
 
+from ..identification.sensor_inputs import SENSOR_TOML_KEYS
+
 __all__ = ["AIRCRAFT_FIELDS", "read_aircraft"]
 
 # The title block: (TOML table, key, label), in the order shown.
@@ -26,6 +28,7 @@ AIRCRAFT_FIELDS = (
     ("test", "date", "Test date"), ("test", "location", "Location"),
     ("test", "pilot", "Pilot"), ("test", "engineer", "Flight-test engineer"),
     ("test", "notes", "Notes"),
+    *(("sensors", key, label) for key, _, _, label in SENSOR_TOML_KEYS),
 )
 _TABLES = tuple(dict.fromkeys(table for table, _, _ in AIRCRAFT_FIELDS))
 _KEYS = {table: [k for t, k, _ in AIRCRAFT_FIELDS if t == table] for table in _TABLES}
