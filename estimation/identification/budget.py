@@ -129,7 +129,8 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     Parameters
     ----------
     flight : pitotcal.core.flight.Flight
-        The flight `result` was identified from (as passed to `identify`).
+        The flight `result` was identified from (as passed to `identify`; corrected here for
+        the probe lever arm `identify` corrected it for, `result.reading["probe_arm_m"]`).
     result : IdentificationResult
     inputs : BudgetInputs, optional
         Standard uncertainties of the Type B inputs; default `BudgetInputs()`.
@@ -151,6 +152,9 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     """
     from .fit import estimate
 
+    arm_m = (result.reading or {}).get("probe_arm_m")
+    if arm_m and not (getattr(flight, "reading", None) or {}).get("probe_arm_m"):
+        flight = lever_arm_corrected(flight, result, arm_m)     # re-solve what was fitted
     inputs, input_list = resolve(inputs, flight)
     rows = result.correction_table()
     vi = np.array([r["vi_kt"] for r in rows])

@@ -155,3 +155,15 @@ def test_corrected_arm_counts_its_own_uncertainty(armed):
     assert record["budget_inputs"] == list(result.budget.input_list)
     arm = next(r for r in record["uncertainty_budget"] if r["source"] == "probe_lever_arm")
     assert arm["origin"] == "default: 10 % of the corrected arm"
+
+
+def test_budget_of_a_corrected_result_from_the_raw_flight(armed):
+    """`uncertainty_budget(raw flight, result)` of a result identify corrected for the arm
+    re-solves the corrected flight: identify's own budget to 1e-4 (the correction made here
+    takes the final fit's wind, identify's the first fit's: they differ by ~1e-6)."""
+    _, offset = armed
+    inputs = dataclasses.replace(ZERO, u_qc_scale=0.01)
+    result = identify(offset, probe_arm_m=ARM_M, budget=inputs)
+    again = bd.uncertainty_budget(offset, result, inputs)
+    for name, term in result.budget.terms_kt.items():
+        np.testing.assert_allclose(again.terms_kt[name], term, rtol=1e-4, atol=1e-9)
