@@ -75,8 +75,9 @@ def budget_summary(result, budget):
     return "\n".join(lines)
 
 
-# the inputs that are no uncertainty, listed under the budget's table
-_SETTINGS = ("sensor_class", "oat_source", "probe_arm_m")
+# the inputs that are no uncertainty, listed under the budget's table, in words
+_SETTINGS = {"sensor_class": "Sensor class", "oat_source": "Temperature source",
+             "probe_arm_m": "Probe lever arm corrected in the data"}
 
 
 def _value(row):
@@ -116,7 +117,8 @@ def budget_report(result):
     by_speed = [{"vi": r["vi_kt"], "u": [r["u_dv_by_source_kt"].get(n) for n in names],
                  "U": r.get("dv_U_kt")} for r in per]
     heads = [SOURCE_LABELS.get(n, (n, n))[1] for n in names]
-    settings = [{"input": r.get("input", ""), "value": _value(r), "origin": r.get("origin", "")}
+    settings = [{"input": _SETTINGS[r["input"]], "value": _value(r),
+                 "origin": r.get("origin", "")}
                 for r in result.get("budget_inputs") or []
                 if isinstance(r, dict) and r.get("input") in _SETTINGS]
     return {"sources": sources, "heads": heads, "by_speed": by_speed, "settings": settings}
