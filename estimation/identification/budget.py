@@ -146,7 +146,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     Notes
     -----
     Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
-    vertical channel): at most 14, each reusing `identify`'s cached solver
+    vertical channel): at most 16, each reusing `identify`'s cached solver
     (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
     identify's estimate without the bounds and consistency checks the budget does not use.
     """
