@@ -261,6 +261,10 @@ def run(args):
     # (`| head`) never costs a file
     params, refused = None, None
     if args.params is not None:
+        arm_m = sensors[0].get("probe_arm_m", 0.0)
+        if arm_m:           # the recommendation refits: the data corrected as the result was
+            from pitotcal.estimation.identification.budget import lever_arm_corrected
+            flight = lever_arm_corrected(flight, result, arm_m)
         try:
             params = _write_params(args, flight, autopilot, current)
         except PitotcalError as exc:        # said after the summary
