@@ -88,7 +88,8 @@ def _static_source_record(result):
 def with_budget(out, budget):
     """`out` (a record) with `dv_U_kt` and `u_dv_by_source_kt` (each source's standard
     uncertainty of ΔV at that speed, kt) per correction row, `uncertainty_budget`,
-    `budget_inputs` (every input, its value and where it came from) and the budget's warnings; the rows are matched by speed (the budget has the table's speeds)."""
+    `budget_inputs` (every input, its value and where it came from) and the budget's
+    warnings; the rows are matched by speed (the budget has the table's speeds)."""
     at = {round(float(v), 6): i for i, v in enumerate(budget.vi_kt)}
     new_rows = []
     for row in out.get("airspeed_correction", []):

@@ -34,8 +34,9 @@ circle has its own radius V + δ_i, V the TAS at the point's mean q_ci, altitude
 the leg's TAS less that one at the same pressure-error ratio Δp/q_ci (the position error of
 legs a knot or two apart is the same fraction of q_c). Each 3-leg subset is then solved by
 Newton's method on |g_i − w|² = (V + δ_i)² from the one-radius circle, and δ_i re-computed with
-the ratio the solution gives until V moves less than 1e-6 m/s (three rounds at most). With
-δ_i = 0 this is the one-radius circle exactly.
+the ratio the solution gives until the ratio moves less than 1e-9 (six rounds at most). With
+δ_i = 0 this is the one-radius circle exactly. A total-temperature column (`LegData.tat_k`)
+is converted with each leg's true Mach at that ratio, in the same rounds.
 """
 
 import dataclasses
@@ -63,7 +64,7 @@ MAX_SUBSETS = 5000
 _MAX_NOTES = 10            # subsets named one by one in the warnings; the rest counted
 _COLLINEAR = 1e-9          # relative smallest singular value of the circle's linear system
 _NEWTON_STEPS = 20         # per-leg radii: Newton from the one-radius circle (3-5 suffice)
-_TAS_ROUNDS = 3            # per-leg TAS re-computed with the solution's pressure-error ratio
+_TAS_ROUNDS = 6            # per-leg TAS re-computed with the solution's pressure-error ratio
 
 
 @dataclass(frozen=True)
@@ -295,7 +296,7 @@ def solve_point(legs, label):
             f"{legs.source}: point {label} has {n} leg{'s' * (n != 1)}: three legs on "
             f"different tracks are needed to solve for TAS and wind")
     g = legs.velocity_ne_mps()[idx]
-    x, sols, jac, refused, dop, delta = _per_leg_solution(legs, idx, g)
+    x, sols, jac, refused, dop, delta, ratio = _per_leg_solution(legs, idx, g)
     notes = [f"{_describe(legs, idx[list(s)])}: subset left out, ground velocities nearly "
              f"collinear (TAS DOP {d:.0f} > {DOP_MAX:g})" for s, d in refused[:_MAX_NOTES]]
     if len(refused) > _MAX_NOTES:
@@ -318,14 +319,16 @@ def solve_point(legs, label):
                      f"fourth leg, or state the GPS accuracy)")
     cov = (jac * sigma ** 2) @ jac.T
     return dataclasses.replace(_finish(legs, label, idx, x, sols, cov, factor, bound, dop, g,
-                                       resid), tas_offsets_mps=delta), notes
+                                       resid, ratio), tas_offsets_mps=delta), notes
 
 
-def _reference(legs, idx):
-    """The point's (mean q_ci, indicated static pressure at the mean altitude, mean OAT)."""
+def _reference(legs, idx, ratio=0.0):
+    """The point's (mean q_ci, indicated static pressure at the mean altitude, mean OAT); the
+    OAT of a total-temperature column at the pressure-error ratio's true Mach."""
+    qc = legs.qci_pa[idx] * (1.0 + ratio)
     return (float(np.mean(legs.qci_pa[idx])),
             float(airdata.static_pressure_pa(float(np.mean(legs.pressure_alt_m[idx])))),
-            float(np.mean(legs.oat_k[idx])))
+            float(np.mean(legs.static_oat_k(qc, idx))))
 
 
 def _tas_at_ratio(qci_pa, ps_ind_pa, oat_k, ratio):
@@ -339,32 +342,36 @@ def _tas_at_ratio(qci_pa, ps_ind_pa, oat_k, ratio):
 def _tas_offsets(legs, idx, ratio):
     """δ_i: each leg's TAS less the point's reference TAS at the same pressure-error ratio."""
     ps_ind = airdata.static_pressure_pa(legs.pressure_alt_m[idx])
-    ref = _tas_at_ratio(*_reference(legs, idx), ratio)
-    return _tas_at_ratio(legs.qci_pa[idx], ps_ind, legs.oat_k[idx], ratio) - ref
+    ref = _tas_at_ratio(*_reference(legs, idx, ratio), ratio)
+    oat = legs.static_oat_k(legs.qci_pa[idx] * (1.0 + ratio), idx)
+    return _tas_at_ratio(legs.qci_pa[idx], ps_ind, oat, ratio) - ref
 
 
 def _per_leg_solution(legs, idx, g):
-    """(x, subset solutions, Jacobian, refused subsets, DOP, δ) with each leg's own TAS: δ at
-    the indicated values first, then at the pressure-error ratio of the solution's TAS."""
-    delta = _tas_offsets(legs, idx, 0.0)
+    """(x, subset solutions, Jacobian, refused subsets, DOP, δ, pressure-error ratio) with each
+    leg's own TAS: δ at the indicated values first, then at the ratio of the solution's TAS
+    (which also sets a total-temperature column's true Mach)."""
+    ratio = 0.0
+    delta = _tas_offsets(legs, idx, ratio)
     sols, jac, refused, dop = _subset_solutions(legs, idx, g, delta)
     x = sols.mean(axis=0)
-    if not np.any(delta):
-        return x, sols, jac, refused, dop, delta
-    qci, ps_ind, oat = _reference(legs, idx)
+    if not np.any(delta) and legs.tat_k is None:
+        return x, sols, jac, refused, dop, delta, ratio
     for _ in range(_TAS_ROUNDS):
-        ratio = float(cas_from_tas_mps(x[2], qci, ps_ind, oat)[1]) / qci - 1.0
-        delta = _tas_offsets(legs, idx, ratio)
-        sols, jac, refused, dop = _subset_solutions(legs, idx, g, delta)
-        moved, x = abs(sols.mean(axis=0)[2] - x[2]), sols.mean(axis=0)
-        if moved < 1e-6:
+        qci, ps_ind, oat = _reference(legs, idx, ratio)
+        new = float(cas_from_tas_mps(x[2], qci, ps_ind, oat)[1]) / qci - 1.0
+        delta, moved, ratio = _tas_offsets(legs, idx, new), abs(new - ratio), new
+        if np.any(delta):
+            sols, jac, refused, dop = _subset_solutions(legs, idx, g, delta)
+            x = sols.mean(axis=0)
+        if moved < 1e-9:
             break
-    return x, sols, jac, refused, dop, delta
+    return x, sols, jac, refused, dop, delta, ratio
 
 
-def _finish(legs, label, idx, x, sols, cov, factor, bound, dop, g, resid):
+def _finish(legs, label, idx, x, sols, cov, factor, bound, dop, g, resid, ratio=0.0):
     """TAS → CAS and ΔV with their half-widths (dV_c/dV_t by central difference)."""
-    qci, ps_ind, oat = _reference(legs, idx)
+    qci, ps_ind, oat = _reference(legs, idx, ratio)
     alt = float(np.mean(legs.pressure_alt_m[idx]))
     ias_mps = float(airdata.cas_from_qc_mps(qci))
     vc, qc = cas_from_tas_mps(x[2], qci, ps_ind, oat)

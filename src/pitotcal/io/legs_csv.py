@@ -15,8 +15,10 @@ instrument-corrected airspeed V_ic) or `qc_pa` (measured impact pressure q_ci), 
 static OAT, `tat_c` or `tat_k`: the indicated total temperature a probe reads (an aircraft's OAT
 gauge reads the air heated by the ram rise), converted as T_s = T_t / (1 + r 0.2 M²) with the
 probe's recovery factor r (`temp_recovery`, default 1: a total-temperature probe; a bare OAT
-gauge probe is nearer 0.7-0.9) and M the leg's indicated Mach (from q_ci at its pressure
-altitude: the position error moves the temperature by < 0.1 K at M 0.3). Optional:
+gauge probe is nearer 0.7-0.9) and M the leg's Mach: `oat_k` at the indicated Mach (q_ci at the
+pressure altitude), `LegData.static_oat_k` at the true one, which the solutions use (3 % of
+position error moves the temperature by 0.04 K at 100 KIAS, 3,000 ft, 0.35 K at 250 KIAS,
+10,000 ft). Optional:
 `duration_s` (the leg's length in time) and `groundspeed_sd_kt` (the standard uncertainty of the
 leg's ground velocity, per component, kt). Extra columns are ignored.
 
@@ -96,6 +98,11 @@ class LegData:
     temperature : str
         Where `oat_k` comes from: "oat_c", "oat_k", or the total-temperature column with its
         recovery factor ("tat_c, recovery factor 0.8").
+    tat_k : ndarray or None
+        The indicated total temperature, K, when the file gives it (`oat_k` is then its static
+        temperature at the indicated Mach; `static_oat_k` at the true one).
+    temp_recovery : float
+        The probe's recovery factor of `tat_k`.
     """
 
     point: tuple
@@ -111,6 +118,8 @@ class LegData:
     lines: tuple = ()
     sd_from: str = "stated"
     temperature: str = "oat_c"
+    tat_k: np.ndarray | None = None
+    temp_recovery: float = DEFAULT_TEMP_RECOVERY
 
     @property
     def n(self):
@@ -123,6 +132,19 @@ class LegData:
     def indices(self, label):
         """Indices of the legs of point `label`."""
         return np.array([i for i, p in enumerate(self.point) if p == label], dtype=int)
+
+    def static_oat_k(self, qc_pa=None, idx=None):
+        """Static OAT of the legs `idx` (all: None), K: `oat_k`; from `tat_k` with the true
+        Mach of impact pressure `qc_pa` when given (the position error in the static source:
+        p_s = p_s,ind + q_ci − q_c), T_s = T_t / (1 + r 0.2 M²)."""
+        from pitotcal.core.moist_air import static_temperature_k
+
+        sel = slice(None) if idx is None else idx
+        if self.tat_k is None or qc_pa is None:
+            return self.oat_k[sel]
+        qci = self.qci_pa[sel]
+        ps = airdata.static_pressure_pa(self.pressure_alt_m[sel]) + qci - qc_pa
+        return static_temperature_k(self.tat_k[sel], qc_pa, ps, self.temp_recovery)
 
     def velocity_ne_mps(self):
         """Ground velocity (north, east), m/s, shape (n, 2)."""
@@ -173,16 +195,17 @@ def read_legs(path, temp_recovery=DEFAULT_TEMP_RECOVERY):
     column = next(c for c in ("oat_k", "oat_c", "tat_k", "tat_c") if c in values)
     kelvin = values[column] + (273.15 if column.endswith("_c") else 0.0)
     alt_m = values["pressure_alt_ft"] * FT_TO_M
-    temperature = column
+    temperature, tat_k = column, None
     if column.startswith("tat"):
         mach = airdata.mach_from_qc(qci, airdata.static_pressure_pa(alt_m))
-        kelvin = kelvin / (1.0 + temp_recovery * 0.2 * mach ** 2)
+        tat_k, kelvin = kelvin, kelvin / (1.0 + temp_recovery * 0.2 * mach ** 2)
         temperature = f"{column}, recovery factor {temp_recovery:g}"
     legs = LegData(point=labels, ias_kt=ias_kt, qci_pa=qci, pressure_alt_m=alt_m, oat_k=kelvin,
                    groundspeed_mps=values["groundspeed_kt"] * KT_TO_MPS,
                    track_deg=values["track_deg"] % 360.0, duration_s=values["duration_s"],
                    groundspeed_sd_mps=values["groundspeed_sd_kt"] * KT_TO_MPS,
-                   source=name, lines=tuple(lines), temperature=temperature)
+                   source=name, lines=tuple(lines), temperature=temperature, tat_k=tat_k,
+                   temp_recovery=temp_recovery)
     _check_speed_units(legs, values, lines, name)
     return legs
 

@@ -126,8 +126,8 @@ def armed():
 
 
 def test_lever_arm_correction_recovers_the_centre_line(armed):
-    """Uncorrected, the 2 m arm shifts ΔV by 0.24-0.29 kt (measured); corrected, ΔV is the centre-line
-    probe's to 0.01 kt, and the record keeps the arm."""
+    """Uncorrected, the 2 m arm shifts ΔV by 0.24-0.29 kt (measured); corrected, ΔV is the
+    centre-line probe's to 0.01 kt, and the record keeps the arm."""
     base, offset = armed
     vi = np.array([74.0, 85.0, 96.0])
     biased = identify(offset).delta_v_kt(vi)[0] - base.delta_v_kt(vi)[0]

@@ -267,3 +267,28 @@ def test_same_ias_is_the_one_radius_circle():
     np.testing.assert_array_equal(sol.tas_offsets_mps, 0.0)
     x = three_leg(_g([178, 185, 188], [178, 82, 355]) * KT_TO_MPS)
     assert (sol.wind_n_mps, sol.wind_e_mps, sol.tas_mps) == pytest.approx(tuple(x), abs=1e-9)
+
+
+@pytest.mark.parametrize("ias_kt", [[250.0, 250.0, 250.0, 250.0], [249.0, 251.0, 250.0, 250.5]])
+def test_total_temperature_converted_with_the_true_mach(ias_kt):
+    """A leg file giving the indicated total temperature (r = 0.8) at 250 KIAS, 10,000 ft with
+    3 % of position error: each leg's static OAT from its true Mach recovers the constructed
+    wind and ΔV; the indicated Mach (0.35 K too warm) would move ΔV by ~0.1 kt."""
+    import dataclasses
+
+    from pitotcal.core import airdata
+
+    legs, w, dv_true = _constructed_point(ias_kt, [0.0, 90.0, 180.0, 270.0], ratio=0.03,
+                                          alt_ft=(10000.0,), oat_k=(268.0,))
+    ps_ind = airdata.static_pressure_pa(legs.pressure_alt_m)
+    m_true = airdata.mach_from_qc(legs.qci_pa * 1.03, ps_ind - 0.03 * legs.qci_pa)
+    m_ind = airdata.mach_from_qc(legs.qci_pa, ps_ind)
+    tat = 268.0 * (1 + 0.8 * 0.2 * m_true ** 2)
+    total = dataclasses.replace(legs, tat_k=tat, temp_recovery=0.8,
+                                oat_k=tat / (1 + 0.8 * 0.2 * m_ind ** 2))
+    sol, _ = solve_point(total, "1")
+    assert np.hypot(sol.wind_n_mps - w[0], sol.wind_e_mps - w[1]) / KT_TO_MPS < 0.01
+    assert sol.dv_kt == pytest.approx(dv_true, abs=0.005)
+    assert sol.oat_k == pytest.approx(268.0, abs=0.005)
+    indicated, _ = solve_point(dataclasses.replace(total, tat_k=None), "1")
+    assert indicated.oat_k - 268.0 > 0.25 and abs(indicated.dv_kt - dv_true) > 0.05
