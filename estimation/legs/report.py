@@ -88,7 +88,10 @@ def _fmt(x, spec):
 
 def legs_summary(legs, points, fit, notes):
     """The text `pitotcal legs` prints (knots, degrees true, wind FROM)."""
-    lines = [f"Legs: {legs.source} ({legs.n} legs, {len(points)} points)", "",
+    temperature = getattr(legs, "temperature", "oat_c")
+    lines = [f"Legs: {legs.source} ({legs.n} legs, {len(points)} points)"
+             + ("" if temperature in ("oat_c", "oat_k") else
+                f"; OAT from {temperature}, at each leg's true Mach"), "",
              ("Per point, the classic solution (±: 95 % half-width; bound: stated GPS accuracy, "
              "samples (the legs' own GPS scatter), leg scatter, or none):"),
              (f"  {'point':<7}{'method':<7}{'KIAS':>6}{'KTAS':>8}{'±':>6}{'wind kt':>9}"

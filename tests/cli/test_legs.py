@@ -120,7 +120,9 @@ def test_indicated_total_temperature_file_gives_the_static_one(tmp_path, capsys)
     a, b = tmp_path / "a.json", tmp_path / "b.json"
     assert main(["legs", str(EXAMPLE), "--json", str(a)]) == 0
     assert main(["legs", str(total), "--temp-recovery", "0.8", "--json", str(b)]) == 0
-    capsys.readouterr()
+    head = next(ln for ln in capsys.readouterr().out.splitlines()
+                if ln.startswith(f"Legs: {total}"))
+    assert head.endswith("; OAT from tat_c, recovery factor 0.8, at each leg's true Mach")
     da, db = json.loads(a.read_text()), json.loads(b.read_text())
     assert db["temperature"] == "tat_c, recovery factor 0.8" and da["temperature"] == "oat_c"
     for pa, pb in zip(da["points"], db["points"]):
