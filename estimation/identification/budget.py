@@ -172,6 +172,9 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     """
     from .fit import estimate
 
+    collapse = (result.consistency or {}).get("collapse")
+    if collapse:        # the result is fitted without a collapsed tail: so are its re-solves
+        flight = flight.select(flight.time_s < collapse["removed_from_s"])
     inputs = (inputs or BudgetInputs()).checked()
     rows = result.correction_table()
     vi = np.array([r["vi_kt"] for r in rows])

@@ -71,6 +71,10 @@ COLLAPSE_FRACTION = 0.2
 # four sigma of 3 m/s turbulence; a draining blockage reaches it in a drain time or so.
 COLLAPSE_RATIO = 0.5
 COLLAPSE_WINDOW_S = 5.0
+# ... provided the fall is this many times the smoothed ratio's own spread over the record
+# (robust std): on a slow aircraft in strong turbulence the smoothed ratio of a clean flight
+# wanders to 0.5 (30-45 kt in 3 m/s gusts), on the T-2 maneuver its spread is ~0.02.
+COLLAPSE_SIGMAS = 6.0
 # ... and by more than this, kt: below what an airspeed indicator shows.
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
@@ -94,7 +98,8 @@ def check(flight, result, air_data):
     hidden = None if jump_note else hidden_warning(flight.source, details)
     ratio = _smoothed_ratio(flight, result, air_data)
     healthy = np.flatnonzero(ratio >= 0.95)
-    details.update(end_ratio=float(ratio[-1]), healthy_until_s=float(
+    spread = 1.4826 * float(np.median(np.abs(ratio - np.median(ratio))))
+    details.update(end_ratio=float(ratio[-1]), ratio_spread=spread, healthy_until_s=float(
         flight.time_s[healthy[-1]] if healthy.size else flight.time_s[0]))
     return tuple(w for w in (step_note, jump_note, hidden) if w), details
 
@@ -193,7 +198,8 @@ def collapse_onset_s(details, time_s):
 
     A collapse: a flagged fall of at least `COLLAPSE_FRACTION` from an onset in the second
     half of the record, or a record whose smoothed q_ci ends below `COLLAPSE_RATIO` of what
-    the GPS gives (``end_ratio``), from where it last stood at 0.95 of it (``healthy_until_s``). The cut is one
+    the GPS gives (``end_ratio``), by more than `COLLAPSE_SIGMAS` of the smoothed ratio's
+    spread (``ratio_spread``), from where it last stood at 0.95 of it (``healthy_until_s``). The cut is one
     onset of the scan earlier: the scan places an onset only to its grid, and the samples
     lost before it were healthy."""
     t0, t1 = float(time_s[0]), float(time_s[-1])
@@ -201,7 +207,8 @@ def collapse_onset_s(details, time_s):
     if details.get("flagged") and details["step"] >= COLLAPSE_FRACTION \
             and details["onset_s"] >= t0 + 0.5 * (t1 - t0):
         onsets.append(details["onset_s"])
-    if details.get("end_ratio", 1.0) < COLLAPSE_RATIO:
+    fall = 1.0 - details.get("end_ratio", 1.0)
+    if fall > 1.0 - COLLAPSE_RATIO and fall > COLLAPSE_SIGMAS * details.get("ratio_spread", 0.0):
         onsets.append(details["healthy_until_s"])
     if not onsets:
         return None

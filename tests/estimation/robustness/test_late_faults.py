@@ -6,6 +6,7 @@ Built from the campaign's cases: a pitot blocked late in a return-sweep flight (
 """
 
 import dataclasses
+import warnings
 
 import numpy as np
 import pytest
@@ -102,3 +103,35 @@ def test_clean_flights_change_warning_rate():
     the change warning near its design rate ALPHA = 1 % (6 of 200 is beyond it at p < 0.5 %)."""
     named = [bool(outcome(None, seed)[1]["named"]) for seed in range(200, 400)]
     assert sum(named) <= 6, sum(named)
+
+
+def test_a_clean_slow_flight_in_strong_turbulence_keeps_its_tail():
+    """30-45 kt in 3 m/s gusts: the smoothed q_ci ratio of a clean flight ends at 0.47, inside
+    its own spread (0.29): no collapse is cut (it was 30 s removed as 'a blocked pitot')."""
+    import pitotcal
+
+    plan = pitotcal.plan_maneuver(cas_min_kt=30, cas_max_kt=45, radius_m=400,
+                                  wind_speed_mps=3, return_leg=True)
+    flight, _ = pitotcal.simulate(plan, seed=12, turbulence_mps=3, k=(0.02, -3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = pitotcal.identify(flight)
+    assert "collapse" not in result.consistency
+    assert result.n_samples == flight.n
+
+
+def test_the_budget_of_a_cut_flight_re_solves_without_the_tail():
+    """The budget perturbs the samples the result was fitted on: with the collapsed tail cut,
+    its terms stay of a clean flight's size (U was 18.6 kt at 70 kt with the tail put back)."""
+    import pitotcal
+    from pitotcal.maneuvers.fly.faults import apply_fault, parse_fault
+
+    plan = pitotcal.plan_maneuver(return_leg=True)
+    flight, truth = pitotcal.simulate(plan, seed=0, keep_history=True)
+    faulty = apply_fault(flight, truth, parse_fault("blocked:215:30"))
+    faulty = faulty[0] if isinstance(faulty, tuple) else faulty
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = pitotcal.identify(faulty, budget=True)
+    assert "collapse" in result.consistency
+    assert max(result.budget.expanded_kt) < 3.0
