@@ -55,7 +55,10 @@ def outcome(kind, seed, turbulence_mps=0.5):
     details = {"fault": None if fault is None else fault.to_dict(), "worst_sigma": worst,
                "lowest_vi_kt": float(vi[0]), "named": named,
                "collapse": result.consistency.get("collapse"),
-               "z": result.consistency.get("z"), "threshold": result.consistency.get("threshold")}
+               "z": result.consistency.get("z"), "threshold": result.consistency.get("threshold"),
+               "kind": result.consistency.get("kind"),
+               "end_ratio": result.consistency.get("end_ratio"),
+               "ratio_spread": result.consistency.get("ratio_spread")}
     if named:
         return "warned", details
     return ("within" if worst <= 3.0 else "missed"), details
