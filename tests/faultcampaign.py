@@ -14,13 +14,15 @@ import pitotcal
 from pitotcal.core.models import delta_v_kt, get_model
 from pitotcal.maneuvers.fly.faults import Fault, apply_fault
 
-# what names a late or gradual fault (consistency.step_test, jumps.jump_test, the collapse)
-NAMED = ("changes during the flight", "q_ci collapses", "jumps at")
+# what names a late or gradual fault (consistency.step_test, jumps.jump_test, the collapse,
+# consistency.tail_warning)
+NAMED = ("changes during the flight", "q_ci collapses", "jumps at", "q_ci drifts low")
 
 
 @functools.lru_cache(maxsize=None)
-def return_plan():
-    return pitotcal.plan_maneuver(return_leg=True)
+def return_plan(return_leg=True):
+    """The default plan, flown up and back down the speeds (or one way)."""
+    return pitotcal.plan_maneuver(return_leg=return_leg)
 
 
 def late_fault(kind, seed, duration_s):
@@ -36,10 +38,10 @@ def late_fault(kind, seed, duration_s):
     return Fault(kind, onset, size)
 
 
-def outcome(kind, seed, turbulence_mps=0.5):
+def outcome(kind, seed, turbulence_mps=0.5, return_leg=True):
     """(outcome, details) of one flight: "warned", "within" or "missed"; `kind` None: clean."""
-    flight, truth = pitotcal.simulate(return_plan(), seed=seed, turbulence_mps=turbulence_mps,
-                                      keep_history=True)
+    flight, truth = pitotcal.simulate(return_plan(return_leg), seed=seed,
+                                      turbulence_mps=turbulence_mps, keep_history=True)
     fault = None
     if kind is not None:
         fault = late_fault(kind, seed, float(flight.time_s[-1]))
@@ -58,7 +60,8 @@ def outcome(kind, seed, turbulence_mps=0.5):
                "z": result.consistency.get("z"), "threshold": result.consistency.get("threshold"),
                "kind": result.consistency.get("kind"),
                "end_ratio": result.consistency.get("end_ratio"),
-               "ratio_spread": result.consistency.get("ratio_spread")}
+               "ratio_spread": result.consistency.get("ratio_spread"),
+               "tail_sigmas": (result.consistency.get("tail_drift") or {}).get("sigmas")}
     if named:
         return "warned", details
     return ("within" if worst <= 3.0 else "missed"), details

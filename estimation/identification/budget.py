@@ -172,9 +172,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     """
     from .fit import estimate
 
-    collapse = (result.consistency or {}).get("collapse")
-    if collapse:        # the result is fitted without a collapsed tail: so are its re-solves
-        flight = flight.select(flight.time_s < collapse["removed_from_s"])
+    flight = _fitted_samples(flight, result)
     inputs = (inputs or BudgetInputs()).checked()
     rows = result.correction_table()
     vi = np.array([r["vi_kt"] for r in rows])
@@ -186,7 +184,6 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
         u_rh = RH_U_GIVEN_PCT if flight.rh_pct is not None else RH_U_UNKNOWN_PCT
     inputs = dataclasses.replace(inputs, u_rh_pct=u_rh)
     notes = []
-
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
 
     def sensitivity(perturb, name):
@@ -232,6 +229,15 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
                   inputs={name: (abs(getattr(inputs, field)), unit)
                           for name, field, unit in SOURCES},
                   warnings=tuple(dict.fromkeys(notes)))
+
+
+def _fitted_samples(flight, result):
+    """The samples `result` was fitted on: without a collapsed tail it removed
+    (`consistency.collapse_onset_s`), so its re-solves are fitted on the same."""
+    collapse = (result.consistency or {}).get("collapse")
+    if not collapse:
+        return flight
+    return flight.select(flight.time_s < collapse["removed_from_s"])
 
 
 # --- perturbed flights (Flight, result, signed step) -> Flight --------------------------------
