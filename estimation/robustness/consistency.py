@@ -209,13 +209,14 @@ def step_test(flight, result, air_data):
     onsets = t[np.searchsorted(t, t[0] + ONSETS * (t[-1] - t[0]))]
     first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
     bound = float(normal_isf(ALPHA / (2.0 * len(KINDS) * ONSETS.size)))
-    threshold = bound + MARGIN
-    scan = _scan(jac, r, _Alternatives(np.asarray(ch.qci, float), t, first), threshold)
+    scan = _scan(jac, r, _Alternatives(np.asarray(ch.qci, float), t, first), bound + MARGIN)
+    threshold = max(bound + MARGIN, t_bound(ALPHA / (2.0 * len(KINDS) * ONSETS.size),
+                                            scan["dof"]))
     z = scan["beta"] / scan["sigma"]
     best = scan["best"]
     kind, at = KINDS[best // ONSETS.size], best % ONSETS.size
     details = {"onset_s": float(onsets[at]), "kind": kind, "step": float(-scan["beta"][best]),
-               "z": float(z[best]), "threshold": threshold, "alpha": ALPHA,
+               "z": float(z[best]), "threshold": threshold, "alpha": ALPHA, "dof": scan["dof"],
                "flagged": bool(abs(z[best]) > threshold)}
     # the maneuver's geometry: the Gaussian bound of a scan of the steps it states alone
     # (`hidden_bound`), as the margin is for the noise model's tails
@@ -227,6 +228,27 @@ def step_test(flight, result, air_data):
     if details["flagged"]:
         return _change_warning(flight.source, details, t[-1]), details
     return None, details
+
+
+def t_bound(tail, dof):
+    """The |z| bound of two-sided probability 2 `tail` when the sigma comes from a noise model
+    fitted with `dof` degrees of freedom (`ColoredCovariance.dof`: one per few correlation
+    times of the residuals): Student's t quantile, over the t widening at 2 sigma that the
+    colored covariance already carries; the normal one for infinite `dof`.
+
+    A record only a few turbulence correlation times long (a slow aircraft in strong
+    turbulence: 30-45 kt in 3 m/s gusts, correlation times of 20-30 s in a 240 s record)
+    leaves the noise model's variance uncertain, and z = coefficient / sigma then has the
+    t's heavy tails, not the normal's (docs/measured.md).
+    """
+    from scipy.stats import t as student_t
+
+    from pitotcal.core.information import student_t_widening
+
+    if not np.isfinite(dof):
+        return float(normal_isf(tail))
+    v = max(float(dof), 3.0)        # as the covariance's own widening takes it
+    return float(student_t.isf(tail, v)) / student_t_widening(v)
 
 
 def hidden_bound(n_onsets):
@@ -399,6 +421,7 @@ def _scan(jac, r, g, threshold):
     s2 = np.array([max(rr - c @ xr[idx], 0.0) for c, idx in zip(coef, cols)]) / max(n - p - 1, 1)
     sigma = np.sqrt(s2 * np.array([mk[-1, -1] for mk in inv_k]))
     plain = sigma.copy()
+    dof = float("inf")
     best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
     if abs(beta[best]) > threshold * sigma[best]:
         x = np.column_stack([jac, g.column(best)])
@@ -408,12 +431,16 @@ def _scan(jac, r, g, threshold):
         b = max(1, int(np.ceil(n / _BLOCKS)))
         xb = block_means(x, b)
         eb = block_means(r - x @ coef[best], b)
-        cov = colored_covariance(xb, eb, window=_WINDOW, velocity=xb[:, p - 2:p]).covariance
-        sigma[best] = np.sqrt(max(cov[-1, -1], sigma[best] ** 2))
+        colored = colored_covariance(xb, eb, window=_WINDOW, velocity=xb[:, p - 2:p])
+        white, var = sigma[best] ** 2, float(colored.covariance[-1, -1])
+        sigma[best] = np.sqrt(max(var, white))
+        # Welch-Satterthwaite: only the part beyond the white noise's is uncertain
+        if var > white:
+            dof = float(colored.dof) * (var / (var - white)) ** 2
     m_inv = np.linalg.inv(gram[:p, :p])
     # how far the plain fit moves per unit of q_ci low (s = -beta): r is q_ci - predicted
     shift = (m_inv @ gram[:p, p:]).T
-    return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:],
+    return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:], "dof": dof,
             "shift": shift[1:],
             "shift_all": shift[0], "cov_plain": float(np.mean(s2[1:])) * m_inv}
 

@@ -161,3 +161,41 @@ def test_the_budget_of_a_cut_flight_re_solves_without_the_tail():
         result = pitotcal.identify(faulty, budget=True)
     assert "collapse" in result.consistency
     assert max(result.budget.expanded_kt) < 3.0
+
+
+def _slow_uav_flight(seed, turbulence_mps):
+    """30-45 kt flown up and back down in strong turbulence: correlation times of 20-30 s in
+    a 240 s record."""
+    plan = pitotcal.plan_maneuver(cas_min_kt=30, cas_max_kt=45, radius_m=400,
+                                  wind_speed_mps=3, return_leg=True)
+    flight, _ = pitotcal.simulate(plan, seed=seed, turbulence_mps=turbulence_mps, k=(0.02, -3))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return pitotcal.identify(flight)
+
+
+def test_t_bound_is_the_normal_one_for_many_degrees_of_freedom():
+    tail = consistency.ALPHA / 108
+    normal = consistency.t_bound(tail, float("inf"))
+    assert normal == pytest.approx(3.74, abs=0.01)
+    bounds = [consistency.t_bound(tail, dof) for dof in (3.0, 10.0, 30.0, 1e4)]
+    assert bounds == sorted(bounds, reverse=True) and bounds[-1] == pytest.approx(normal, abs=0.01)
+    # dof below the covariance's own floor (3) are taken at it
+    assert consistency.t_bound(tail, 1.0) == consistency.t_bound(tail, 3.0)
+
+
+def test_clean_slow_flight_in_strong_turbulence_is_not_flagged():
+    """Seed 1 in 3 m/s gusts: the best step has z = +5.0, beyond the normal bound plus MARGIN
+    (4.24); its noise model has ~9.5 degrees of freedom, and the t bound (5.1) holds it."""
+    details = _slow_uav_flight(1, 3.0).consistency
+    assert 4.24 < details["z"] < details["threshold"], details
+    assert 5 < details["dof"] < 15 and not details["flagged"]
+
+
+@pytest.mark.slow
+def test_slow_uav_flights_change_warning_rate():
+    """28 clean 30-45 kt flights in 2 and 3 m/s turbulence (seeds 0-13): the change warning on
+    at most 2 (measured 1; 3 with the normal bound plus MARGIN alone)."""
+    flagged = [_slow_uav_flight(seed, turb).consistency["flagged"]
+               for turb in (2.0, 3.0) for seed in range(14)]
+    assert sum(flagged) <= 2, flagged
