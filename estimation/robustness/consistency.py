@@ -9,10 +9,13 @@ fraction by which q_ci changed at t0, and s / sigma_s, with sigma_s from the col
 covariance of the augmented fit, is close to standard normal when the calibration is one.
 Beside the step, a ramp q_ci (t - t0)+ / (t_end - t0) takes a gradual change (a blockage
 draining, ice growing). t0 is scanned over `ONSETS`, the whole record; the threshold is
-Bonferroni over both kinds of the scan plus `MARGIN` for the noise model's heavier tails, so a
-clean flight is flagged at about the rate `ALPHA` (measured: docs/measured.md). A large fall
-from an onset in the second half is a collapse (`collapse_onset_s`): the identification
-removes that tail and says so.
+Bonferroni over both kinds of the scan plus `MARGIN` for the noise model's heavier tails, or
+Student's t at the noise model's degrees of freedom where that is larger (`t_bound`: a record
+only a few turbulence correlation times long), so a clean flight is flagged at about the rate
+`ALPHA` or less (measured: docs/measured.md). A q_ci that ends low against the GPS, beyond
+the record's own wander, is named too (`tail_warning`). A large fall from an onset in the
+second half is a collapse (`collapse_onset_s`): the identification removes that tail and says
+so.
 
 The same covariance says what the test cannot see: a step smaller than
 (bound + z_POWER) sigma_s is missed more often than 1 - `POWER`, and the fit absorbs it
