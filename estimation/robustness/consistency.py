@@ -196,8 +196,9 @@ def step_test(flight, result, air_data):
         Names the onset and the size when |z| exceeds the threshold (`hidden_warning` says
         when a step the test would miss moves ΔV by several bands).
     details : dict
-        ``onset_s``, ``step`` (fraction, q_ci low when positive), ``z``, ``threshold``,
-        ``alpha``, ``flagged``; ``undetected`` (the onset where a missed step matters most:
+        ``onset_s``, ``kind``, ``step`` (fraction, q_ci low when positive), ``z``,
+        ``threshold`` (`t_bound` at ``dof`` when larger than the normal bound plus `MARGIN`),
+        ``dof``, ``alpha``, ``flagged``; ``undetected`` (the onset where a missed step matters most:
         ``onset_s``, ``step`` the smallest step detected at ``power``, ``dv_shift_kt`` the
         largest ΔV shift it causes, at ``vi_kt``, against ``dv_2sigma_kt`` there,
         ``k_shift_sigma`` the coefficients' shift in their own covariance) and ``hidden``
