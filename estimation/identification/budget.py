@@ -185,6 +185,7 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
     """The airspeed budget of `uncertainty_budget`; each source's re-solves go to `solved`."""
     from .fit import estimate
 
+    flight = _fitted_samples(flight, result)
     arm_m = (result.reading or {}).get("probe_arm_m")
     if arm_m and not (getattr(flight, "reading", None) or {}).get("probe_arm_m"):
         flight = lever_arm_corrected(flight, result, arm_m)     # re-solve what was fitted
@@ -195,7 +196,6 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
     kwargs = {**identify_kwargs, "gps_noise_std_mps": result.gps_noise_std_mps,
               "model": result.model}
     notes = []
-
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
 
     def sensitivity(perturb, name):
@@ -290,6 +290,15 @@ def _rms_change(perturbed, key, base):
         return np.full_like(base, np.nan)
     d = [p[key] - base for p in perturbed]
     return np.sqrt((d[0] ** 2 + d[1] ** 2) / 2.0)
+
+
+def _fitted_samples(flight, result):
+    """The samples `result` was fitted on: without a collapsed tail it removed
+    (`consistency.collapse_onset_s`), so its re-solves are fitted on the same."""
+    collapse = (result.consistency or {}).get("collapse")
+    if not collapse:
+        return flight
+    return flight.select(flight.time_s < collapse["removed_from_s"])
 
 
 # --- perturbed flights (Flight, result, signed step) -> Flight --------------------------------
