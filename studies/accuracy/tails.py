@@ -20,7 +20,7 @@ from ..engine.figures import new_figure, save
 from ..engine.study import MonteCarloStudy
 from .coverage import wilson_interval
 
-__all__ = ["PLANS", "STUDY", "TURBULENCE_MPS", "joint_inside", "task"]
+__all__ = ["PLANS", "STUDY", "TURBULENCE_MPS", "clustered_interval", "joint_inside", "task"]
 
 PLANS = {"one-way": {}, "up-and-down": {"return_leg": True}}
 TURBULENCE_MPS = (0.5, 1.0)
@@ -28,6 +28,8 @@ PARAMETERS = ("k1", "k2", "wind_speed_mps", "wind_from_deg")
 # Joint-normal draws per flight for the expected "every row inside" chance (its standard error
 # is below 0.8 % at any rate).
 JOINT_DRAWS = 4000
+# Seeds of the k-th turbulence level start at seed + k * SEED_STRIDE.
+SEED_STRIDE = 1000
 # Relative step of the central differences of ΔV with respect to each coefficient.
 REL_STEP = 1e-6
 
@@ -127,8 +129,11 @@ def cases(runs, quick):
     grid = [(p, t) for p in PLANS for t in TURBULENCE_MPS]
     if quick:
         grid = [("up-and-down", 0.5)]
-    # the same seeds in every cell (seed + r): `pitotcal simulate --seed` of run r
-    return [{"plan": p, "turbulence_mps": t, "seed_offset": r} for p, t in grid
+    # the plans share seeds (seed + r: `pitotcal simulate --seed` of run r, the turbulence
+    # option scaling one realisation); each turbulence level has its own, so its cells are
+    # independent samples rather than the same gusts made larger
+    return [{"plan": p, "turbulence_mps": t,
+             "seed_offset": r + SEED_STRIDE * TURBULENCE_MPS.index(t)} for p, t in grid
             for r in range(runs)]
 
 
@@ -156,12 +161,15 @@ def cell_summary(good):
     expected = column(good, "joint_expected_2sigma")
     out = {"n_flights": len(good), "n_rows": int(n_rows.sum()),
            "row_coverage_2sigma": float(in_2s.sum() / n_rows.sum()),
-           "row_coverage_2sigma_interval95": _wilson_counts(in_2s.sum(), n_rows.sum()),
+           "row_coverage_2sigma_interval95": clustered_interval(in_2s, n_rows),
            "row_coverage_u": float(in_u.sum() / n_rows.sum()),
-           "row_coverage_u_interval95": _wilson_counts(in_u.sum(), n_rows.sum()),
+           "row_coverage_u_interval95": clustered_interval(in_u, n_rows),
            "all_rows_in_2sigma": float(np.mean(all_2s)),
            "all_rows_in_2sigma_interval95": wilson_interval(all_2s),
            "all_rows_in_2sigma_expected": float(np.mean(expected)),
+           # observed minus expected count over its Poisson-binomial std
+           "all_rows_in_2sigma_z": float((all_2s.sum() - expected.sum())
+                                         / np.sqrt(max(np.sum(expected * (1 - expected)), 1e-12))),
            "all_rows_in_u": float(np.mean(column(good, "all_in_u") > 0.5)),
            "row_z_max_abs_max": float(np.max(column(good, "row_z_max_abs"))),
            "parameters": {}}
@@ -181,16 +189,25 @@ def cell_summary(good):
     return out
 
 
-def _wilson_counts(k, n):
-    mask = np.zeros(int(n), dtype=bool)
-    mask[:int(k)] = True
-    return wilson_interval(mask)
+def clustered_interval(inside, n_rows, z=1.96):
+    """95 % interval of the row coverage sum(inside) / sum(n_rows), flights as the sampling
+    unit: the rows of one flight move together (one k1-k2 error tilts them all), so counting
+    them as independent draws would make the interval several times too narrow."""
+    inside, n_rows = np.asarray(inside, dtype=float), np.asarray(n_rows, dtype=float)
+    m = inside.size
+    if m < 2:
+        return None
+    p = inside.sum() / n_rows.sum()
+    se = np.sqrt(np.sum((inside - p * n_rows) ** 2) / (m * (m - 1))) / n_rows.mean()
+    return [float(max(p - z * se, 0.0)), float(min(p + z * se, 1.0))]
 
 
 def _rms_interval(z):
     """95 % interval of the rms z of n normal z-scores: n rms² / χ²_n at its 2.5 and 97.5 %
     points, the χ² quantiles by Wilson-Hilferty (good to 0.5 % at n = 40)."""
     n = z.size
+    if n < 2:
+        return None
     rms2 = float(np.mean(z ** 2))
     lo_q, hi_q = (n * (1 - 2 / (9 * n) + s * np.sqrt(2 / (9 * n))) ** 3 for s in (1.96, -1.96))
     return [float(np.sqrt(n * rms2 / lo_q)), float(np.sqrt(n * rms2 / hi_q))]

@@ -82,3 +82,21 @@ def test_coverage_tails_lean(tmp_path):
     assert set(cell["parameters"]) >= {"k1", "k2", "wind_speed_mps", "wind_speed_mps_process"}
     assert (tmp_path / "coverage-tails.png").exists()
     assert "rows inside 2σ" in summary["headline"]
+
+
+@pytest.mark.slow
+def test_coverage_tails_full_size(tmp_path):
+    """150 flights per cell, 600 in all (~20 min on 2 cores; docs/measured.md has the table):
+    the rows' pointwise ±2σ hold truth 92-98 % of the time, U at least as often; the share of
+    flights with every row inside agrees with what their own covariances predict (~87 %, not
+    95 %) within 3 standard deviations; k1 and k2 rms z 0.85-1.2."""
+    summary = run_study("coverage-tails", runs=150, out_dir=tmp_path, workers=2, seed=0)
+    assert not summary["errors"] and len(summary["cells"]) == 4
+    for c in summary["cells"]:
+        name = (c["plan"], c["turbulence_mps"])
+        assert 0.92 <= c["row_coverage_2sigma"] <= 0.98, name
+        assert c["row_coverage_u"] >= c["row_coverage_2sigma"], name
+        assert 0.80 <= c["all_rows_in_2sigma_expected"] <= 0.92, name
+        assert abs(c["all_rows_in_2sigma_z"]) < 3.0, name
+        for p in ("k1", "k2"):
+            assert 0.85 <= c["parameters"][p]["rms_z"] <= 1.2, (name, p)
