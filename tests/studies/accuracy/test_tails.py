@@ -86,7 +86,7 @@ def test_coverage_tails_lean(tmp_path):
 
 @pytest.mark.slow
 def test_coverage_tails_full_size(tmp_path):
-    """150 flights per cell, 600 in all (~20 min on 2 cores; docs/measured.md has the table):
+    """150 flights per cell, 600 in all (11 min on 2 workers; docs/measured.md has the table):
     the rows' pointwise ±2σ hold truth 92-98 % of the time, U at least as often; the share of
     flights with every row inside agrees with what their own covariances predict (~87 %, not
     95 %) within 3 standard deviations; k1 and k2 rms z 0.85-1.2."""
