@@ -31,7 +31,16 @@ def test_no_fork_when_sigchld_is_ignored(tmp_path, monkeypatch):
     assert pids == [os.getpid(), os.getpid()]
 
 
-def test_ctrl_c_swallowed_by_a_solver_is_raised_again():
+@pytest.fixture
+def python_ctrl_c():
+    """Python's own Ctrl-C handler for the test: a process started in the background by a
+    non-interactive shell inherits SIGINT ignored, and Python then installs none."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_swallowed_by_a_solver_is_raised_again(python_ctrl_c):
     def solver_that_catches():
         try:
             signal.raise_signal(signal.SIGINT)
