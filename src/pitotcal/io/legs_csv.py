@@ -157,6 +157,7 @@ def read_legs(path):
                    groundspeed_sd_mps=values["groundspeed_sd_kt"] * KT_TO_MPS,
                    source=name, lines=tuple(lines))
     _check_speed_units(legs, values, lines, name)
+    _check_track_unit(values["track_deg"], name)
     return legs
 
 
@@ -264,6 +265,17 @@ def _unit_hint(col, x):
     if col == "oat_k" and -90.0 <= x <= 60.0:
         return " (looks like degC: give kelvin, or name the column oat_c)"
     return ""
+
+
+def _check_track_unit(track, name):
+    """Refuse tracks in radians: spread over more than 1 yet all within 0-2 pi, they are legs
+    flown within 6.3 deg of one another in degrees, which no leg method can use."""
+    if track.size >= 3 and np.ptp(track) >= 1.0 and track.min() >= 0.0 \
+            and track.max() <= 2.0 * np.pi:
+        raise FlightDataError(
+            f"{name}: column track_deg: every track lies within {track.min():.3g}-"
+            f"{track.max():.3g}, as radians would (x 57.2958 to degrees); legs within 6.3 "
+            "degrees of one another cannot separate the wind")
 
 
 def _check_speed_units(legs, values, lines, name):
