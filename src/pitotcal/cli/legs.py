@@ -75,10 +75,12 @@ def _help_constants():
 DETECT_MAX = {"track_tol_deg": 180.0, "groundspeed_tol_kt": 50.0, "ias_tol_kt": 50.0}
 
 
-def _is_flight(path):
+def _is_flight(path, data):
     from pitotcal.io.flight_csv import csv_kind
+    from pitotcal.io.read_once import log_suffix
 
-    return path.suffix.lower() in LOG_SUFFIXES or csv_kind(path) in ("flight", "plan")
+    return (path.suffix.lower() in LOG_SUFFIXES or log_suffix(data) is not None
+            or csv_kind(data) in ("flight", "plan"))
 
 
 def _series_options(args):
@@ -102,33 +104,34 @@ def run(args):
 
     choice("model", args.model, list(MODELS))
     choice("wind", args.wind, WIND_CHOICES)
-    from pitotcal.io.read_once import is_stream
+    from pitotcal.io.read_once import is_stream, read_once
 
     source = Path(args.legs)
     if not source.is_file() and not is_stream(source):
         raise PitotcalError(f"{source}: no such file", param="legs")
-    flight = _is_flight(source)
+    data = read_once(source)        # a stream is read here once; each reader gets its bytes
+    flight = _is_flight(source, data)
     check_outputs({"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out},
                   [(source, f"the input {'flight file' if flight else 'leg file'}")],
                   figures=["--plot"])
     if flight:
-        return _run_flight(args, source)
+        return _run_flight(args, source, data)
     given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out",
                          "--start-s", "--end-s", "--oat-c")
              if getattr(args, f[2:].replace("-", "_")) is not None]
     if given:
         raise PitotcalError(f"{given[0]}: only for a flight time series; {source} is a leg "
                             f"file", param=given[0])
-    return _run_legs(args, source)
+    return _run_legs(args, source, data)
 
 
-def _run_legs(args, source):
+def _run_legs(args, source, data):
     from pitotcal.estimation.legs.report import analyze_legs, legs_json, legs_summary, plot_legs
     from pitotcal.io.jsonfile import write_json
     from pitotcal.io.legs_csv import read_legs
 
     plot_path = _plot_path(args)
-    legs = read_legs(source)
+    legs = read_legs(data)
     points, fit, notes = analyze_legs(legs, model=args.model, wind=args.wind)
     # files first, then the summary: a reader that goes away early never costs a file
     if args.json is not None:
@@ -156,7 +159,7 @@ def _windows(text):
     return parse_windows(text)
 
 
-def _run_flight(args, source):
+def _run_flight(args, source, data):
     from .common import oat_k_from_c
     from pitotcal.core.checks import number
     from pitotcal.core.errors import PitotcalError
@@ -176,7 +179,7 @@ def _run_flight(args, source):
     tol = 3.0 if args.point_tol_kt is None else number("--point-tol-kt", args.point_tol_kt,
                                                         0.0, 50.0, lo_open=True)
     windows = _windows(args.windows)
-    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+    flight = read_flight(data, start_s=args.start_s, end_s=args.end_s,
                          oat_k=oat_k_from_c(args.oat_c))
     span_s = float(flight.time_s[-1] - flight.time_s[0])
     for key in ("min_leg_s", "smooth_s"):          # a window longer than the data holds nothing

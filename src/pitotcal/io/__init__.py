@@ -16,6 +16,7 @@ from pitotcal.core.moist_air import check_air_options, with_static_air
 from .flight_checks import check_window
 from .flight_csv import read_flight_csv, write_flight_csv
 from .plan_csv import read_plan, write_plan
+from .read_once import log_suffix, read_once
 from .result_record import read_result
 from .streams import LOG_EXTENSIONS
 
@@ -45,7 +46,8 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
     ----------
     path : str or path-like
         A flight CSV (docs/interfaces.md §1) or a log: `.ulg` (PX4 ULog), `.bin`/`.log` (ArduPilot
-        DataFlash), read by `pitotcal.io.logs.read_log`.
+        DataFlash), read by `pitotcal.io.logs.read_log`; ``-`` (standard input) or a FIFO is
+        read once, whole (`pitotcal.io.read_once`), a log on it known by its first bytes.
     start_s, end_s : float, optional
         Keep only samples with start_s <= time_s <= end_s, s (e.g. cut off taxi and take-off).
         Validation (the 1 % bad-row rule) applies inside this window only.
@@ -86,7 +88,8 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
     temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
     reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                "temp_recovery": temp_recovery, "rh_pct": rh_pct}
-    if is_log_file(path):
+    path = read_once(path)          # "-" or a FIFO: read whole once, each reader gets the bytes
+    if is_log_file(path) or log_suffix(path):       # a log by its name, or on a stream by its bytes
         from .logs import read_log
         flight = read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k)
         return with_reading(with_static_air(flight, temp_recovery=temp_recovery,

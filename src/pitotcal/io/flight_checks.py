@@ -382,8 +382,8 @@ def check_time_by_acceleration(name, t, vn, ve):
     GPS noise (a 0.1 m/s velocity noise differenced over 1 s is 0.14 m/s^2).
     """
     span = float(t[-1] - t[0])
-    # in minutes a log of 1 Hz or more steps less than 1/60: slower ones are no calibration log
-    if t.size < 10 or not span > 0.0 or not float(np.median(np.diff(t))) < 1.0 / 60.0:
+    # in minutes a log of 1 Hz or more steps 1/60 or less: slower ones are no calibration log
+    if t.size < 10 or not span > 0.0 or not float(np.median(np.diff(t))) <= 1.001 / 60.0:
         return
     window = min(1.0, span / 4.0)
     later = t[t <= t[-1] - window]
