@@ -246,6 +246,34 @@ def _tomls(root):
             (root / f"ac_{name}.toml").write_text(body)
 
 
+def _plans(root, plan):
+    """Plan CSVs with a bad comment value (the simulator's wind) or a bad body."""
+    lines = plan.read_text().splitlines()
+    head = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+
+    def write(name, new_lines):
+        (root / f"plan_{name}.csv").write_text("\n".join(new_lines) + "\n")
+
+    for key, value in (("wind_speed_mps", "nan"), ("wind_speed_mps", "1e9"),
+                       ("wind_speed_mps", "abc"), ("wind_speed_mps", "-5"),
+                       ("wind_from_deg", "nan"), ("wind_from_deg", "[1, 2]")):
+        write(f"{key}_{value[:3]}", [f"# {key}: {value}" if line.startswith(f"# {key}:")
+                                     else line for line in lines])
+    body = [line.split(",") for line in lines[head + 1:]]
+    for name, edit in (("cell_nan", lambda r: r.__setitem__(1, "nan")),
+                       ("cell_text", lambda r: r.__setitem__(1, "fast")),
+                       ("cas_zero", lambda r: r.__setitem__(lines[head].split(",").index(
+                           "cas_mps"), "0"))):
+        rows = [list(r) for r in body]
+        edit(rows[3])
+        write(name, lines[:head + 1] + [",".join(r) for r in rows])
+    write("reversed", lines[:head + 1] + lines[head + 1:][::-1])
+    write("header_only", lines[:head + 1])
+    write("one_row", lines[:head + 2])
+    write("no_columns", lines[:head])
+    write("short_row", lines[:head + 3] + [lines[head + 3].rsplit(",", 2)[0]])
+
+
 def _legs(root):
     head = "point,ias_kt,pressure_alt_ft,oat_c,groundspeed_kt,track_deg\n"
     good = ["1,100,3000,10,100,0", "1,100,3000,10,110,120", "1,100,3000,10,90,240",
@@ -301,6 +329,7 @@ def files(tmp_path_factory):
     _results(root, out["result"])
     _tomls(root)
     _legs(root)
+    _plans(root, out["plan"])
     (root / "folder").mkdir()
     (root / "folder.csv").mkdir()
     (root / "folder.json").mkdir()
@@ -467,6 +496,27 @@ def _output_cases():
     return cases
 
 
+PLAN_VARIANTS = ["wind_speed_mps_nan", "wind_speed_mps_1e9", "wind_speed_mps_abc",
+                 "wind_speed_mps_-5", "wind_from_deg_nan", "wind_from_deg_[1,", "cell_nan",
+                 "cell_text", "cas_zero", "reversed", "header_only", "one_row", "no_columns",
+                 "short_row"]
+
+
+def _plan_cases():
+    """A plan CSV with a bad comment value or body: named by its file and line or column,
+    never as a flag the user did not give."""
+    cases = []
+    for name in PLAN_VARIANTS:
+        words = ("comment line",) if name.startswith("wind") else ("plan_",)
+        cases.append(Case(f"simulate plan {name}", ["simulate", f"{{root}}/plan_{name}.csv",
+                                                    "-o", "{out}/f.csv"], words=words))
+    for what in ("flight.csv", "result.json", "flight.bin", "legs.csv", "utf16.csv",
+                 "empty.csv"):
+        cases.append(Case(f"simulate plan {what}", ["simulate", f"{{root}}/{what}", "-o",
+                                                    "{out}/f.csv"]))
+    return cases
+
+
 def _stream_cases():
     with_log = {"identify": ["identify", "-", "--no-budget"], "legs": ["legs", "-"],
                 "monitor": ["monitor", "-", "--calibration", "{result}"]}
@@ -476,6 +526,17 @@ def _stream_cases():
              for c, argv in with_log.items() for n, d in data.items()]
     cases += [Case(f"identify fifo {n}", ["identify", "{out}/in.fifo", "--no-budget"],
                    fifo=n) for n in data]
+    # autopilot logs on a pipe or a FIFO: read once, as from their file
+    logs = {"identify": ["identify", "{src}", "--no-budget"],
+            "convert": ["convert", "{src}", "-o", "{out}/c.csv"], "legs": ["legs", "{src}"]}
+    for command, template in logs.items():
+        for log, ok in (("log_bin", True), ("log_ulg", True), ("trunc50.bin", False),
+                        ("random.ulg", False)):
+            codes = (0, 2) if ok and command == "legs" else (0,) if ok else (2,)
+            cases.append(Case(f"{command} stdin {log}", _with(template, "-"), codes=codes,
+                              extra={"stdin_file": log}))
+        cases.append(Case(f"{command} fifo log_bin", _with(template, "{out}/in.bin"),
+                          fifo="log_bin", codes=(0, 2) if command == "legs" else (0,)))
     cases += [Case("report stdin garbage", ["report", "-", "-o", "{out}/r.html"],
                    stdin=b"{not json"),
               Case("monitor calibration stdin", ["monitor", "{flight}", "--calibration", "-"],
@@ -541,7 +602,7 @@ def _option_cases():
 
 
 CASES = (_flight_cases() + _log_cases() + _result_cases() + _aircraft_cases() + _legs_cases()
-         + _path_cases() + _output_cases() + _stream_cases() + _option_cases())
+         + _plan_cases() + _path_cases() + _output_cases() + _stream_cases() + _option_cases())
 
 
 # --- the runner ------------------------------------------------------------------------------
@@ -574,9 +635,10 @@ def _prepare(case, files, out):
         os.mkfifo(out / "pipe")
     cleanups = []
     if case.fifo is not None:
-        fifo = out / "in.fifo"
+        fifo = out / ("in.bin" if case.fifo.startswith("log_") else "in.fifo")
         os.mkfifo(fifo)
-        payload = dict(_stream_data())[case.fifo]
+        payload = (files[case.fifo].read_bytes() if case.fifo.startswith("log_")
+                   else _stream_data()[case.fifo])
 
         def feed():
             try:
@@ -613,7 +675,11 @@ class _Stdin:
 def run_case(case, files, out, capsys, monkeypatch):
     """(exit status, stderr, problem or None) of one case."""
     argv = [_fill(a, files, out) for a in case.argv]
-    if case.stdin is not None:
+    if "stdin_file" in case.extra:
+        name = case.extra["stdin_file"]
+        data = (files[name] if name in files else files["root"] / name).read_bytes()
+        monkeypatch.setattr(sys, "stdin", _Stdin(data))
+    elif case.stdin is not None:
         monkeypatch.setattr(sys, "stdin", _Stdin(case.stdin))
     cleanups = _prepare(case, files, out)
     inputs = [Path(a) for a in argv if a.startswith(str(files["root"]))]
