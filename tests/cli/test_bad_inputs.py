@@ -383,7 +383,8 @@ def _flight_cases():
     for command, template in FLIGHT_READERS.items():
         for unit in units:
             cases.append(Case(f"{command} unit {unit}", _with(template, f"{{root}}/unit_{unit}.csv"),
-                              words=("rho_kgm3",) if unit == "rho_lbft3" else ("looks like",)))
+                              words=("looks like lb/ft^3",) if unit == "rho_lbft3"
+                              else ("looks like",)))
     missing = ["missing_time_s", "missing_qc_pa", "missing_gps_vn_mps", "missing_gps_ve_mps",
                "missing_rho_kgm3_ps_pa", "missing_rho_kgm3_oat_k"]
     odd = ["renamed", "duplicate_column", "header_only", "five_rows", "constant_time",

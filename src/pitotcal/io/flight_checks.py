@@ -206,7 +206,10 @@ def check_rho(name, rho):
     med = float(np.median(rho))
     if 0.15 <= med <= 1.6:
         return
-    unit = " (looks like g/m^3)" if 150 <= med <= 1600 else ""
+    # the density in another unit: g/m^3, lb/ft^3 (1 lb/ft^3 = 16.0185 kg/m^3), slug/ft^3
+    units = (("g/m^3", 1e-3), ("lb/ft^3", 16.0185), ("slug/ft^3", 515.379))
+    unit = next((f" (looks like {u}: x {k:g} to kg/m^3)" for u, k in units
+                 if 0.15 <= med * k <= 1.6), "")
     raise FlightDataError(f"{name}: column rho_kgm3: median {med:.4g} is not an air density in "
                           f"kg/m^3 (0.15-1.6){unit}")
 
