@@ -331,6 +331,8 @@ def files(tmp_path_factory):
     _legs(root)
     _plans(root, out["plan"])
     (root / "folder").mkdir()
+    (root / "alfa").mkdir()
+    (root / "alfa" / "scaled_pressure.csv").write_text("a,b\n1,2\n")
     (root / "folder.csv").mkdir()
     (root / "folder.json").mkdir()
     (root / "aircraft.toml").write_text('aircraft = "T-2"\n')
@@ -603,6 +605,22 @@ def _option_cases():
               Case("report --speed-range-kt reversed", base["report"] + ["--speed-range-kt",
                                                                          "120", "60"]),
               Case("study unknown", ["study", "nothing"]),
+              Case("study --out a file", ["study", "budget", "--quick", "--out", "{flight}"],
+                   words=("--out",)),
+              Case("demo --out a file", ["demo", "--out", "{flight}"], words=("--out",)),
+              Case("demo --out through a file", ["demo", "--out", "{flight}/demo"]),
+              Case("study real-alfa --data empty", ["study", "real-alfa", "--data",
+                                                    "{root}/folder", "--out", "{out}"],
+                   words=("--data",)),
+              Case("study real-alfa --data missing", ["study", "real-alfa", "--data",
+                                                      "{root}/nowhere", "--out", "{out}"],
+                   words=("--data",)),
+              Case("study real-alfa --data garbage", ["study", "real-alfa", "--data",
+                                                      "{root}/alfa", "--out", "{out}"],
+                   words=("scaled_pressure.csv",)),
+              Case("study --run-index past the grid", ["study", "budget", "--quick",
+                                                       "--run-index", "100000", "--out",
+                                                       "{out}"]),
               Case("no command", []),
               Case("unknown command", ["calibrate"])]
     return cases
