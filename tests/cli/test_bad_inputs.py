@@ -471,6 +471,10 @@ def _path_cases():
                           ("dangling", f"{{root}}/dangling.{ext_name}"),
                           ("through-file", f"{{flight}}/x{ext}")):
             cases.append(Case(f"{name} input {what}", _with(template, src)))
+        # a file that opens but cannot be read (EIO): the unreadable file root can have
+        cases.append(Case(f"{name} input unreadable", _with(template, "/proc/self/mem"),
+                          words=("/proc/self/mem",), skip="" if os.path.exists("/proc/self/mem")
+                          else "no /proc here"))
     return cases
 
 

@@ -153,7 +153,10 @@ def _windows(text):
     if text is None:
         return None
     if Path(text).is_file():
-        return read_windows(text)
+        from pitotcal.io.read_once import naming
+
+        with naming(text):
+            return read_windows(text)
     if text.lower().endswith(".csv"):
         raise PitotcalError(f"--windows {text}: no such file", param="windows")
     return parse_windows(text)

@@ -16,7 +16,7 @@ from pitotcal.core.moist_air import check_air_options, with_static_air
 from .flight_checks import check_window
 from .flight_csv import read_flight_csv, write_flight_csv
 from .plan_csv import read_plan, write_plan
-from .read_once import log_suffix, read_once
+from .read_once import log_suffix, naming, read_once
 from .result_record import read_result
 from .streams import LOG_EXTENSIONS
 
@@ -88,7 +88,14 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
     temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
     reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                "temp_recovery": temp_recovery, "rh_pct": rh_pct}
-    path = read_once(path)          # "-" or a FIFO: read whole once, each reader gets the bytes
+    with naming(path):
+        return _read_flight(read_once(path), reading)
+
+
+def _read_flight(path, reading):
+    """`read_flight` of `path` (a file, or a stream's bytes read once) with `reading` checked."""
+    start_s, end_s, oat_k = reading["start_s"], reading["end_s"], reading["oat_k"]
+    temp_recovery, rh_pct = reading["temp_recovery"], reading["rh_pct"]
     if is_log_file(path) or log_suffix(path):       # a log by its name, or on a stream by its bytes
         from .logs import read_log
         flight = read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k)

@@ -60,7 +60,7 @@ from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import ISA_T0_K, density_kgm3
 
 from .atomic import atomic_open
-from .read_once import open_binary, read_once
+from .read_once import naming, open_binary, read_once
 from .flight_checks import (
     check_plausible,
     check_ps_oat,
@@ -186,7 +186,11 @@ def csv_kind(path):
 
     Looks only at the header (after any ``#`` lines); never raises for a file it can open.
     """
-    path = read_once(path)
+    with naming(path):
+        return _csv_kind(read_once(path))
+
+
+def _csv_kind(path):
     name = str(path)
     try:
         _reject_binary(path, name)

@@ -31,7 +31,7 @@ from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
 from .atomic import atomic_open
-from .read_once import open_binary, read_once
+from .read_once import naming, open_binary, read_once
 
 __all__ = ["LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
@@ -131,9 +131,10 @@ def read_legs(path):
         Unusable file, missing column, bad cell or implausible unit; one line naming file,
         column and row.
     """
-    path = read_once(path)          # "-", a FIFO or a pipe: read whole once
-    name = str(path)
-    header, rows, lines = _read_rows(path, name)
+    with naming(path):
+        path = read_once(path)          # "-", a FIFO or a pipe: read whole once
+        name = str(path)
+        header, rows, lines = _read_rows(path, name)
     cols = _choose_columns(header, name)
     values = {c: _column(c, header, rows, lines, name) for c in cols if c != "point"}
     for c in _OPTIONAL:

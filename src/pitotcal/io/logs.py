@@ -72,7 +72,7 @@ from .airborne import airspeed_gate, flight_state_cuts
 from .flight_checks import QCI_MIN_FLYING_PA, check_window, implausible_samples, window_text
 from .flight_csv import PLAN_NOT_FLIGHT, csv_kind
 from .flightlog import AutopilotWind, FlightLog
-from .read_once import log_file
+from .read_once import log_file, naming
 from .streams import LOG_EXTENSIONS
 from .timebase import apply_cuts, clean, gps_onto, spans
 
@@ -155,7 +155,7 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     options = _check_options(gps_resample, gps_latency_s, min_groundspeed_mps, min_qci_pa, oat_k,
                              min_airspeed_mps)
     start_s, end_s = check_window(start_s, end_s)
-    with log_file(path, LOG_EXTENSIONS) as file:        # "-" or a FIFO: its bytes, once
+    with naming(path), log_file(path, LOG_EXTENSIONS) as file:   # "-" or a FIFO: read once
         streams = _read_streams(Path(file))
     return _assemble(streams, Path(file).name, start_s, end_s, options)
 

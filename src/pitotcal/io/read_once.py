@@ -26,7 +26,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-__all__ = ["STDIN", "InputBytes", "is_stream", "log_file", "log_suffix", "open_binary",
+__all__ = ["STDIN", "InputBytes", "is_stream", "log_file", "log_suffix", "naming", "open_binary",
            "read_once"]
 
 STDIN = "-"                  # the input path that means standard input
@@ -106,6 +106,18 @@ def log_file(source, suffixes):
         path = Path(folder) / name
         path.write_bytes(source.data)
         yield path
+
+
+@contextlib.contextmanager
+def naming(path):
+    """An `OSError` raised inside that names no file (a read's EIO, not an open's ENOENT)
+    names `path`: the command line's one line then says which input failed."""
+    try:
+        yield
+    except OSError as exc:
+        if not exc.filename:
+            exc.filename = str(path)
+        raise
 
 
 def open_binary(source):
