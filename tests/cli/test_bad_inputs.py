@@ -728,6 +728,7 @@ def run_case(case, files, out, capsys, monkeypatch):
     before = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in inputs
               if p.is_file() and not p.is_symlink()}
     listing = sorted(os.listdir(files["root"]))
+    sigint = signal.getsignal(signal.SIGINT)
     previous = signal.signal(signal.SIGALRM, _on_alarm)
     signal.alarm(LIMIT_S)
     problem = None
@@ -749,6 +750,9 @@ def run_case(case, files, out, capsys, monkeypatch):
             clean()
     err = capsys.readouterr().err
     code = 0 if code is None and problem is None else code
+    if problem is None and signal.getsignal(signal.SIGINT) is not sigint:
+        problem = f"the Ctrl-C handler was left changed: {signal.getsignal(signal.SIGINT)}"
+        signal.signal(signal.SIGINT, sigint)
     if problem is None:
         after = {p: hashlib.sha256(p.read_bytes()).hexdigest() for p in before}
         if after != before or sorted(os.listdir(files["root"])) != listing:
@@ -778,6 +782,7 @@ def _judge(case, code, err, problem):
 def test_bad_input(case, files, tmp_path, capsys, monkeypatch):
     if case.skip:
         pytest.skip(case.skip)
+    monkeypatch.chdir(tmp_path)         # a stray relative output lands here, not in the tree
     code, err, problem = run_case(case, files, tmp_path, capsys, monkeypatch)
     verdict = _judge(case, code, err, problem)
     assert verdict is None, f"pitotcal {' '.join(case.argv)}: {verdict}\n{err.strip()[-600:]}"
