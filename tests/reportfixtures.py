@@ -6,10 +6,11 @@ import numpy as np
 
 
 def result_json(dv_kt=-1.0, band_kt=0.3, u_kt=None, dh_ft=None, dh_2sigma_ft=2.0,
-                vi_kt=(70.0, 100.0), step_kt=5.0, legs=False):
+                vi_kt=(70.0, 100.0), step_kt=5.0, legs=False, altitude_ft=0.0, dh_u_ft=None):
     """A result dict whose correction is the constant `dv_kt` (or a function of V_i) with 2σ
     `band_kt`; `u_kt` adds dv_U_kt (and an uncertainty budget), `dh_ft` adds the altimeter
-    columns and the compressible air-data keys."""
+    columns (at the indicated pressure altitude `altitude_ft`; `dh_u_ft` their expanded U) and
+    the compressible air-data keys."""
     vi = np.arange(vi_kt[0], vi_kt[1] + 1e-9, step_kt)
     rows = []
     for v in vi:
@@ -22,6 +23,8 @@ def result_json(dv_kt=-1.0, band_kt=0.3, u_kt=None, dh_ft=None, dh_2sigma_ft=2.0
             row.update(mach_i=float(v) / 661.5, dmach=d / 661.5,
                        dh_ft=float(dh_ft(v) if callable(dh_ft) else dh_ft),
                        dh_2sigma_ft=dh_2sigma_ft)
+            if dh_u_ft is not None:
+                row["dh_U_ft"] = float(dh_u_ft(v) if callable(dh_u_ft) else dh_u_ft)
         rows.append(row)
     out = {
         "model": "inverse", "formula": "dp/qc = k1 + k2/qci",
@@ -41,6 +44,8 @@ def result_json(dv_kt=-1.0, band_kt=0.3, u_kt=None, dh_ft=None, dh_2sigma_ft=2.0
                                      {"source": "transducer calibration", "u_dv_kt": 0.2}]
     if dh_ft is not None:
         out["air_data"] = "compressible"
+        out["static_source"] = {"assumed": "all pressure error in the static source",
+                                "pressure_altitude_ic_ft": altitude_ft}
     if legs:
         out["points"] = [{"point": i + 1, "ias_kt": 70.0 + 10 * i, "tas_kt": 73.0 + 10 * i,
                           "tas_2sigma_kt": 0.4, "wind_speed_kt": 9.8, "wind_from_deg": 270.0,

@@ -128,6 +128,7 @@ def test_lower_layers_import_nothing_above_them(graph, layer):
 # "__init__" is the package's own namespace; top-level modules are named by their module name.
 SUBLAYERS = {
     "pitotcal.estimation": {"uncertainty": 0, "robustness": 1, "identification": 2,
+                            "survey": 2,
                             "monitor": 3, "legs": 3, "reporting": 4, "live": 5, "__init__": 6},
     "pitotcal.maneuvers": {"turbulence": 0, "plan": 1, "fly": 2, "__init__": 3},
     "pitotcal.studies": {"names": 0, "engine": 0, "accuracy": 1, "design": 1, "legs": 1,

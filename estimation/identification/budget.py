@@ -34,6 +34,11 @@ The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a coun
 - qc_scale, qc_offset: the transducer's calibration, u = 0.1 % of reading and 1 Pa (a
   calibrated flight-test transducer; a hobby MEMS sensor is 1 % and 5-10 Pa): ΔV_pc is the
   position error only if the transducer's own error is known to this.
+
+A compressible result's static-source products, the altimeter correction ΔH_pc (ft) and the
+Mach correction ΔM_pc, get the same budget from the same re-solves: each perturbed calibration
+is carried to ΔH and ΔM at the table's speeds (`static_source.static_source_products`) and
+differenced as ΔV is, and the statistical part is their own 2σ / 2 (`Budget.products`).
 """
 
 import dataclasses
@@ -115,6 +120,9 @@ class Budget:
     inputs : dict
         Source name -> (standard uncertainty of the input, unit).
     warnings : tuple of str
+    products : dict
+        Static-source product ("dh_ft", "dmach") -> {"statistical": σ at each speed, source
+        name -> u_j at each speed}, in the product's unit; empty for an incompressible result.
     """
 
     vi_kt: np.ndarray
@@ -122,6 +130,7 @@ class Budget:
     terms_kt: dict
     inputs: dict
     warnings: tuple = ()
+    products: dict = dataclasses.field(default_factory=dict)
 
     @property
     def combined_kt(self):
@@ -133,6 +142,21 @@ class Budget:
     def expanded_kt(self):
         """U = k u_c, k = 2, at each speed, kt."""
         return COVERAGE_K * self.combined_kt
+
+    def product_expanded(self, name):
+        """U = k u_c of a static-source product (`products`) at each speed."""
+        terms = self.products[name]
+        return COVERAGE_K * np.sqrt(sum(t ** 2 for t in terms.values()))
+
+    def product_row(self, i):
+        """The correction row's static-source budget keys at speed index `i`: dh_U_ft,
+        u_dh_by_source_ft, dmach_U, u_dmach_by_source (empty without `products`)."""
+        out = {}
+        for key, (u_key, by_key) in _PRODUCT_KEYS.items():
+            if key in self.products:
+                out[u_key] = float(self.product_expanded(key)[i])
+                out[by_key] = {n: float(u[i]) for n, u in self.products[key].items()}
+        return out
 
     def to_list(self):
         """The JSON's `uncertainty_budget`: statistical first, each u_dv_kt its max over V_i."""
@@ -169,7 +193,16 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     vertical channel): at most 14, each reusing `identify`'s cached solver
     (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
     identify's estimate without the bounds and consistency checks the budget does not use.
+    A compressible result's ΔH_pc and ΔM_pc get their budget from the same re-solves
+    (`Budget.products`).
     """
+    solved = {}                         # source -> its two re-solves, for ΔH and ΔM
+    budget = _resolved_budget(flight, result, inputs, identify_kwargs, solved)
+    return dataclasses.replace(budget, products=_products_budget(result, budget, solved))
+
+
+def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
+    """The airspeed budget of `uncertainty_budget`; each source's re-solves go to `solved`."""
     from .fit import estimate
 
     inputs = (inputs or BudgetInputs()).checked()
@@ -202,6 +235,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
                              f"({res.message})")
             dv.append(delta_v_kt_where_defined(get_model(res.model), res.coefficients, vi,
                                                res.air_data) - dv0)
+            solved.setdefault(name, []).append(res)
         u = np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
         if not np.all(np.isfinite(u)):
             notes.append(f"uncertainty budget: the {name} term is not computed at "
@@ -229,6 +263,54 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
                   inputs={name: (abs(getattr(inputs, field)), unit)
                           for name, field, unit in SOURCES},
                   warnings=tuple(dict.fromkeys(notes)))
+
+
+# static-source product -> the JSON row's keys of its U and of its terms
+_PRODUCT_KEYS = {"dh_ft": ("dh_U_ft", "u_dh_by_source_ft"),
+                 "dmach": ("dmach_U", "u_dmach_by_source")}
+# static-source product -> the correction table's 2σ column of it
+_PRODUCT_BANDS = {"dh_ft": "dh_2sigma_ft", "dmach": "dmach_2sigma"}
+
+
+def _products_budget(result, budget, solved):
+    """`Budget.products`: each product's statistical part (its 2σ / 2) and, per term in the
+    budget's order, the RMS change of its two re-solves; a term without them has the ΔV
+    term's zeros (no input) or NaN (refused)."""
+    from .static_source import static_source_products
+
+    vi = budget.vi_kt
+    if result.air_data != "compressible" or result.ps_pa is None:
+        return {}
+    grid = static_source_products(result, vi)
+    out = {}
+    for key, band in _PRODUCT_BANDS.items():
+        terms = {"statistical": np.asarray(grid[band], dtype=float) / 2.0}
+        for name, u_dv in budget.terms_kt.items():
+            pair = solved.get(name, [])
+            terms[name] = (_rms_change([_static_products(r, vi) for r in pair], key,
+                                       np.asarray(grid[key], dtype=float))
+                           if len(pair) == 2 else u_dv * 0.0)
+        out[key] = terms
+    return out
+
+
+def _static_products(result, vi):
+    """{"dh_ft", "dmach"} of a compressible result at the speeds `vi`; {} otherwise."""
+    from .static_source import static_source_products
+
+    if result.air_data != "compressible" or result.ps_pa is None:
+        return {}
+    grid = static_source_products(result, vi)
+    return {key: np.asarray(grid[key], dtype=float) for key in ("dh_ft", "dmach")}
+
+
+def _rms_change(perturbed, key, base):
+    """sqrt((d₊² + d₋²) / 2) of a product's change in the two re-solves (NaN where one has
+    none: a re-solve refused or a product undefined)."""
+    if len(perturbed) < 2 or key not in perturbed[0] or key not in perturbed[1]:
+        return np.full_like(base, np.nan)
+    d = [p[key] - base for p in perturbed]
+    return np.sqrt((d[0] ** 2 + d[1] ** 2) / 2.0)
 
 
 # --- perturbed flights (Flight, result, signed step) -> Flight --------------------------------

@@ -5,9 +5,14 @@ record carries (its JSON: `estimation.identification.record`).
 """
 
 import dataclasses
+import functools
+
+import numpy as np
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.measurement import DEFAULT_AIR_DATA
+from pitotcal.core.measurement import DEFAULT_AIR_DATA, INCOMPRESSIBLE_MACH_MAX, flight_mach
+from pitotcal.core.moist_air import at_mach
+from pitotcal.core.units import wind_vector_mps
 from pitotcal.io.result_record import check_noise_model
 
 from ..uncertainty.block_noise import block_residual_stats
@@ -25,7 +30,7 @@ from .fit import (
 from .view import correction_table
 
 __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG",
-           "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
+           "TEMPERATURE_TOL_K", "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
 
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
@@ -99,11 +104,37 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     -15.0...
     """
     inputs = budget_inputs(budget)
-    result = fit(flight, model, air=air, gps_noise_std_mps=gps_noise_std_mps,
-                 ipopt_options=ipopt_options, gps_error_sigma_mps=gps_error_sigma_mps,
-                 gps_error_tau_s=gps_error_tau_s)
+    refit = functools.partial(fit, model=model, air=air, gps_noise_std_mps=gps_noise_std_mps,
+                              ipopt_options=ipopt_options, gps_error_sigma_mps=gps_error_sigma_mps,
+                              gps_error_tau_s=gps_error_tau_s)
+    result, flight = _at_calibrated_mach(refit(flight), flight, refit)
     return complete(result, flight, air=air, budget=inputs,
                     gps_error=(gps_error_sigma_mps, gps_error_tau_s))
+
+
+# The total-to-static temperature conversion is iterated until T_s moves less than this, K
+TEMPERATURE_TOL_K = 0.005
+_MAX_TEMPERATURE_PASSES = 4
+
+
+def _at_calibrated_mach(result, flight, refit):
+    """(result, flight) with the static temperature made from the total one (`tat_k`) at the
+    calibration's true Mach instead of the indicated one, fitted again until it settles.
+
+    The reader converts T_t with the indicated Mach (q_ci / p_s,ind), the only one it has:
+    off by the position error's ΔM (0.25 K at Mach 0.47 with a 2 % static error). A flight
+    whose `oat_k` was not made from `tat_k` is returned as it is.
+    """
+    first = flight
+    for _ in range(_MAX_TEMPERATURE_PASSES):
+        again = at_mach(first, static_source.calibrated_mach(result, first))
+        if again is None:
+            break
+        step = float(np.max(np.abs(again.oat_k - flight.oat_k)))
+        flight, result = again, refit(again)
+        if step < TEMPERATURE_TOL_K:
+            break
+    return result, flight
 
 
 def budget_inputs(budget):
@@ -144,6 +175,7 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
         reading=None if reading is None else dict(reading), source=str(flight.source),
         n_dropped=int(flight.n_dropped))
     result = _with_warning(_with_warning(result, noise_note), _static_note(result))
+    result = _with_warning(result, _incompressible_note(result, flight))
     if budget is None:
         return result
     try:
@@ -175,6 +207,21 @@ def _static_note(result):
     if result.air_data != "compressible" or result.ps_pa is None:
         return None
     return static_source.unavailable_warning(result, correction_table(result))
+
+
+def _incompressible_note(result, flight):
+    """The warning of an incompressible fit of a flight flown above Mach 0.3, or None."""
+    if result.air_data != "incompressible":
+        return None
+    wind = wind_vector_mps(result.value("wind_speed_mps"), result.value("wind_from_deg"))
+    mach = float(np.nanpercentile(flight_mach(flight, *wind), 99))
+    if not mach > INCOMPRESSIBLE_MACH_MAX:
+        return None
+    return (f"{result.source}: fitted with the incompressible air data (q_c = ½ρV_t²) up to "
+            f"Mach {mach:.2f}: above Mach {INCOMPRESSIBLE_MACH_MAX:g} the impact pressure "
+            f"exceeds ½ρV_t² by about M²/4 ({25 * mach ** 2:.1f} % at Mach {mach:.2f}), "
+            "which the fit takes into the pressure-error coefficients and ΔV; fit with the "
+            "compressible air data (`air` \"compressible\"; it needs ps_pa and oat_k)")
 
 
 def _with_warning(result, note):

@@ -87,8 +87,9 @@ def _static_source_record(result):
 
 def with_budget(out, budget):
     """`out` (a record) with `dv_U_kt` and `u_dv_by_source_kt` (each source's standard
-    uncertainty of ΔV at that speed, kt) per correction row, `uncertainty_budget`, and the
-    budget's warnings; the rows are matched by speed (the budget has the table's speeds)."""
+    uncertainty of ΔV at that speed, kt) per correction row, a compressible result's ΔH and ΔM
+    the same (`Budget.product_row`), `uncertainty_budget`, and the budget's warnings; the rows
+    are matched by speed (the budget has the table's speeds)."""
     at = {round(float(v), 6): i for i, v in enumerate(budget.vi_kt)}
     new_rows = []
     for row in out.get("airspeed_correction", []):
@@ -96,7 +97,8 @@ def with_budget(out, budget):
         new_rows.append({**row, **({"dv_U_kt": None} if i is None else {
             "dv_U_kt": float(budget.expanded_kt[i]),
             "u_dv_by_source_kt": {"statistical": float(budget.statistical_kt[i]),
-                                  **{n: float(u[i]) for n, u in budget.terms_kt.items()}}})})
+                                  **{n: float(u[i]) for n, u in budget.terms_kt.items()}},
+            **budget.product_row(i)})})
     warnings = list(out.get("warnings", []))
     warnings += [w for w in budget.warnings if w not in warnings]
     return json_ready({**out, "airspeed_correction": new_rows,

@@ -21,8 +21,9 @@ error is measured, Δp_p = p_s,ind − p_s,ref, and fitted by the same structure
 covariance); the total-pressure error is the rest, δp_T = p_T,ind − p_T = Δp_p − (q_c − q_ci).
 ΔM_pc and ΔH_pc then use the measured static error, and the rows add δp_T / q_cic.
 
-Each product exists only where its law does: Mach below 1 and pressure altitudes in the ISA
-troposphere. Elsewhere it is NaN (null in the JSON) and `unavailable_warning` names it, so a
+Each product exists only where its law does: Mach up to `airdata.MACH_MAX` (the Rayleigh
+pitot law above Mach 1) and pressure altitudes in the ISA (−2,000 ft to 32 km). Elsewhere it is
+NaN (null in the JSON) and `unavailable_warning` names it, so a
 calibration far out (a short or rough record) is still returned with what can be computed.
 """
 
@@ -33,7 +34,8 @@ from pitotcal.core.models import get_model, qc_from_qci_pa
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import kt_to_mps, m_to_ft
 
-__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "fitted_static_error",
+__all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "calibrated_mach",
+           "fitted_static_error",
            "plot_altimeter_correction",
            "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",
            "static_source_products", "static_statement", "static_table_lines",
@@ -51,10 +53,10 @@ def pressure_altitude_ic_m(result):
     if result.ps_pa is None:
         return None
     ps = float(np.median(result.ps_pa))
-    return float(airdata.pressure_altitude_m(ps)) if _in_troposphere(ps) else None
+    return float(airdata.pressure_altitude_m(ps)) if _in_isa(ps) else None
 
 
-def _in_troposphere(ps_pa):
+def _in_isa(ps_pa):
     """Where `airdata.pressure_altitude_m` is defined (numpy bool, the shape of `ps_pa`)."""
     lo, hi = (float(airdata.static_pressure_pa(h)) for h in (airdata.PRESSURE_ALTITUDE_MAX_M,
                                                              airdata.PRESSURE_ALTITUDE_MIN_M))
@@ -62,12 +64,12 @@ def _in_troposphere(ps_pa):
     return np.isfinite(ps) & (ps >= lo) & (ps <= hi)
 
 
-def _subsonic(qc_pa, ps_pa):
-    """Where `airdata.mach_from_qc` is defined: |q_c| / p_s up to Mach 1."""
+def _in_mach_range(qc_pa, ps_pa):
+    """Where `airdata.mach_from_qc` is defined: |q_c| / p_s up to Mach `airdata.MACH_MAX`."""
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.abs(qc_pa) / ps_pa
     return np.isfinite(ratio) & (np.asarray(ps_pa) > 0) \
-        & (ratio <= airdata.QC_SONIC_PA / airdata.P0_PA)
+        & (ratio <= airdata.QC_OVER_PS_MAX)
 
 
 def _on(ok, fun, *args):
@@ -78,6 +80,25 @@ def _on(ok, fun, *args):
         out[ok] = fun(*(np.broadcast_to(np.asarray(a, dtype=float), ok.shape)[ok]
                         for a in args))
     return out
+
+
+def calibrated_mach(result, flight):
+    """The true Mach of each sample of `flight` by the calibration `result`, ndarray (N,).
+
+    q_c = q_ci / (1 − f(q_ci; k)) and p_s = p_s,ind − (q_c − q_ci) (all the error in the static
+    source), or the reference static pressure when the result used one; the indicated Mach
+    (q_ci / p_s,ind) where the calibration gives none.
+    """
+    qci = np.asarray(flight.qci_pa, dtype=float)
+    ps_ind = np.asarray(flight.ps_pa, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        qc = qc_from_qci_pa(get_model(result.model), result.coefficients, qci)
+    ps = (np.asarray(flight.ps_ref_pa, dtype=float)
+          if result.ps_ref_pa is not None and flight.ps_ref_pa is not None
+          else ps_ind - (qc - qci))
+    mach = _on(_in_mach_range(qc, ps), airdata.mach_from_qc, qc, ps)
+    indicated = _on(_in_mach_range(qci, ps_ind), airdata.mach_from_qc, qci, ps_ind)
+    return np.where(np.isfinite(mach), mach, np.nan_to_num(indicated))
 
 
 def static_error_fit(result):
@@ -120,9 +141,9 @@ def _products(model, kk, vi_kt, ps_ind_pa, n_k):
         qc = qc_from_qci_pa(model, k, qci)
         dp = qc - qci if k_static.size == 0 else qc * model(k_static, qci)
     ps = ps_ind_pa - dp
-    mach_i = _on(_subsonic(qci, ps_ind_pa), airdata.mach_from_qc, qci, ps_ind_pa)
-    dmach = _on(_subsonic(qc, ps), airdata.mach_from_qc, qc, ps) - mach_i
-    dh = _on(_in_troposphere(ps) & _in_troposphere(ps_ind_pa), lambda d: (
+    mach_i = _on(_in_mach_range(qci, ps_ind_pa), airdata.mach_from_qc, qci, ps_ind_pa)
+    dmach = _on(_in_mach_range(qc, ps), airdata.mach_from_qc, qc, ps) - mach_i
+    dh = _on(_in_isa(ps) & _in_isa(ps_ind_pa), lambda d: (
         airdata.altimeter_correction_m(d, airdata.pressure_altitude_m(ps_ind_pa))), dp)
     return dp / qci, mach_i, dmach, dh, (dp - (qc - qci)) / qci
 
@@ -163,7 +184,7 @@ def static_source_products(result, vi_kt, plain=False):
            "dmach": values[2], "dmach_2sigma": bands[1], "dh_ft": m_to_ft(values[3]),
            "dh_2sigma_ft": m_to_ft(bands[2]),
            "pressure_altitude_ic_ft": (float(m_to_ft(airdata.pressure_altitude_m(ps_ind)))
-                                       if _in_troposphere(ps_ind) else None)}
+                                       if _in_isa(ps_ind) else None)}
     if reference:
         out.update(dpt_qcic=values[4], dpt_qcic_2sigma=bands[3], k_static=kk[n_k:],
                    k_static_std=np.sqrt(np.diag(cov[n_k:, n_k:])))
@@ -214,7 +235,7 @@ def plot_altimeter_correction(ax, result, vi_range_kt):
     ax.plot(vi, dh, color="tab:green", lw=2, label="ΔH_pc = H_c − H_ic")
     h_ic = grid["pressure_altitude_ic_ft"]
     ax.set(xlabel="indicated airspeed V_i (kt)", ylabel="ΔH_pc (ft)",
-           title="Altimeter correction " + ("not defined outside the ISA troposphere"
+           title="Altimeter correction " + ("not defined outside the ISA (-2,000 ft to 32 km)"
                                             if h_ic is None else
                                             f"at {h_ic:.0f} ft pressure altitude"))
     ax.legend(fontsize=8, loc="best")
@@ -235,7 +256,8 @@ def static_statement(result):
 def air_data_lines(result):
     """The compressible summary's statement of what was computed and assumed."""
     return [
-        ("Air data: compressible (isentropic q_c from V_t, the static port's p_s and T_s); "
+        ("Air data: compressible (isentropic q_c from V_t, Rayleigh pitot above Mach 1; the "
+         "static port's p_s and T_s); "
          "KIAS = V_ic and KCAS = V_c by the standard CAS law, ΔV = ΔV_pc."),
         (f"{'Assumed' if result.ps_ref_pa is None else 'Measured'}: "
          f"{static_statement(result)[0]}."),
@@ -246,7 +268,7 @@ def air_data_lines(result):
 def static_table_lines(result, table):
     """Static-source position error per row: Δp_p/q_cic, M_ic, ΔM_pc, ΔH_pc with 2σ."""
     h_ic = pressure_altitude_ic_m(result)
-    where = ("outside the ISA troposphere: no altimeter correction" if h_ic is None
+    where = ("outside the ISA (-2,000 ft to 32 km): no altimeter correction" if h_ic is None
              else f"{m_to_ft(h_ic):.0f} ft")
     lines = [
         "",
@@ -291,6 +313,6 @@ def unavailable_warning(result, table):
              for name, vi in missing.items()]
     h_ic = pressure_altitude_ic_m(result)
     return (f"{result.source}: static-source products not computed: {'; '.join(parts)}: "
-            "the calibration puts the static pressure there beyond Mach 1 or outside the "
-            "ISA troposphere" + (" (the flight's median static pressure is outside it)"
+            "the calibration puts the static pressure there beyond Mach "
+            f"{airdata.MACH_MAX:g} or outside the ISA (-2,000 ft to 32 km)" + (" (the flight's median static pressure is outside it)"
                                  if h_ic is None else "") + "; the airspeed correction stands")

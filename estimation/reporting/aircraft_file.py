@@ -6,6 +6,12 @@ line naming the key: a file that is not TOML; a key that is a misspelling of a k
 (``registraton``, ``[aircaft]``: it would show under a wrong label and leave the field "not
 stated"); a known field that is not text, a number or a date; NaN or infinite numbers
 anywhere; a negative or zero weight; a negative speed (a key whose name says it is one).
+
+The rule's speeds, KCAS, in [aircraft]: vs0_kcas, vs1_kcas (Part 23), vsr0_kcas, vsr1_kcas
+(Part 25), vfe_kcas, vmo_kcas, vne_kcas; they must be positive numbers. With
+`configuration` one of cruise, takeoff, approach, landing they set the compliance verdict's
+speed ranges (`aircraft_rule`); any other configuration text is shown and the airspeed check
+keeps the flown range, except a misspelling of one of those words, which is refused.
 """
 
 import datetime
@@ -15,7 +21,9 @@ import tomllib
 
 from pitotcal.core.errors import PitotcalError
 
-__all__ = ["AIRCRAFT_FIELDS", "read_aircraft"]
+from .regulations import CONFIGURATIONS, STALL_SPEED_KEYS
+
+__all__ = ["AIRCRAFT_FIELDS", "aircraft_rule", "read_aircraft"]
 
 # The title block: (TOML table, key, label), in the order shown.
 AIRCRAFT_FIELDS = (
@@ -23,6 +31,7 @@ AIRCRAFT_FIELDS = (
     ("aircraft", "serial", "Serial number"), ("aircraft", "configuration", "Configuration"),
     ("aircraft", "weight", "Weight"), ("aircraft", "cg", "Centre of gravity"),
     ("aircraft", "pitot_static", "Pitot-static installation"),
+    *(("aircraft", key, f"{symbol} (KCAS)") for key, symbol in STALL_SPEED_KEYS),
     ("test", "date", "Test date"), ("test", "location", "Location"),
     ("test", "pilot", "Pilot"), ("test", "engineer", "Flight-test engineer"),
     ("test", "notes", "Notes"),
@@ -58,6 +67,43 @@ def read_aircraft(path):
             if (table, key) not in seen:
                 rows.append((f"{table}.{key}" if key else table, str(value)))
     return rows
+
+
+def aircraft_rule(path):
+    """{"configuration", "speeds_kcas"} of an aircraft TOML for the compliance verdict.
+
+    configuration is one of `regulations.CONFIGURATIONS` or None (absent, or free text);
+    speeds_kcas maps the symbols of `regulations.STALL_SPEED_KEYS` to the speeds given.
+
+    Raises
+    ------
+    PitotcalError
+        As `read_aircraft`; and a speed that is not a positive number, or a configuration that
+        misspells one of the known ones, naming the key.
+    """
+    doc = _load(path)
+    _check(doc, path)
+    table = doc.get("aircraft") if isinstance(doc.get("aircraft"), dict) else {}
+    speeds = {}
+    for key, symbol in STALL_SPEED_KEYS:
+        value = table.get(key)
+        if value is None:
+            continue
+        if not isinstance(value, (int, float)) or isinstance(value, bool) or value <= 0:
+            raise PitotcalError(f"`aircraft_path` {path}: key aircraft.{key}: {value!r} is "
+                                "not a speed (a positive number of KCAS)")
+        speeds[symbol] = float(value)
+    text = table.get("configuration")
+    configuration = str(text).strip().lower() if text is not None else None
+    if configuration not in CONFIGURATIONS:
+        near = difflib.get_close_matches(configuration or "", CONFIGURATIONS, n=1,
+                                         cutoff=_MISSPELT)
+        if near:
+            raise PitotcalError(f"`aircraft_path` {path}: key aircraft.configuration: "
+                                f"{text!r} is not one of {', '.join(CONFIGURATIONS)}; did "
+                                f"you mean {near[0]!r}?")
+        configuration = None
+    return {"configuration": configuration, "speeds_kcas": speeds}
 
 
 def _load(path):

@@ -27,25 +27,42 @@ the largest |ΔV_model − ΔV_constant| (kt) with that model's ΔV 2σ there, a
 V_c / IAS).
 
 Refusals (a `PitotcalError`, exit 2, one line): the track turned through less than
-`MIN_TRACK_SPREAD_DEG`; the constant-model fit did not converge; the inverse or linear model
-departs from the constant one by more than its own 2σ somewhere in the flown range (one scale
-cannot represent the error: the scale right at cruise is wrong near the stall; a
-`ParameterRefused` carrying the structure misfit); the 2σ of the new value is wider than
-`TOLERANCE` of it while the current value lies inside that band (the flight cannot improve on it).
+`MIN_TRACK_SPREAD_DEG`; the constant-model fit did not converge; one scale cannot represent the
+error (the scale right at cruise is wrong near the stall; a `ParameterRefused` carrying the
+structure misfit): the structure misfit exceeds `misfit_tolerance_kt` (default
+`MISFIT_TOLERANCE_KT`, a third of the 5 kt airspeed limit of 23.1323(b)/25.1323(c)) *and* that
+model departs from the constant one by more than its own 2σ there (practically and
+statistically significant: a departure of 0.03 kt, however certain, costs nothing); the 2σ of
+the new value is wider than `TOLERANCE` of it while the current value lies inside that band (the
+flight cannot improve on it).
+
+PX4's sensor model. PX4 applies ASPD_SCALE to its IAS *after* its own compensation of an SDP3x
+sensor's tube and pitot losses (``CAL_AIR_CMODEL`` with ``CAL_AIR_TUBELEN``,
+``CAL_AIR_TUBED_MM``; PX4 ``lib/airspeed/airspeed.cpp``, ``calc_IAS_corrected``), while the scale
+here is V_c relative to sqrt(2 Δp / ρ₀) of the logged Δp. When the log enables an SDP3x
+(``SENS_EN_SDP3X``) the recommendation warns and states what PX4's compensation adds at the
+median q_ci flown (models 0 and 1, the sensor's flow model; model 2's tube loss is not
+evaluated): the scale to load is about the one written divided by that factor.
 """
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from pitotcal.core.checks import number
 from pitotcal.core.errors import ObservabilityError, PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA
 from pitotcal.core.propagation import band, gradient
 from pitotcal.core.units import RHO0_KGM3
 from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
-__all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "TOLERANCE", "ParameterRecommendation",
-           "ParameterRefused", "misfit_text", "recommend", "write_parameter_file"]
+from .compliance import REGULATIONS
+
+__all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "MISFIT_TOLERANCE_KT",
+           "MISFIT_TOLERANCE_MAX_KT", "TOLERANCE", "ParameterRecommendation", "ParameterRefused",
+           "check_misfit_tolerance", "misfit_text", "px4_sensor_note", "recommend",
+           "write_parameter_file"]
 
 # A parameter is committed only after turning through three quarters of a circle: wind and
 # scale then separate with margin (identify itself needs only more than half a circle).
@@ -55,6 +72,12 @@ MIN_TRACK_SPREAD_DEG = 270.0
 TOLERANCE = 0.01
 # The parameter written when the log has none of its names (PX4: the current name first)
 PARAMETER = {"ArduPilot": ARDUPILOT_RATIO, "PX4": PX4_SCALES[0]}
+# The structure misfit one value may have before it is refused, kt: a third of the smallest
+# airspeed limit (5 kt), so that a single scale leaves two thirds of the limit to the rest of
+# the position error and the calibration's own uncertainty
+MISFIT_TOLERANCE_KT = REGULATIONS["23.1323"]["floor_kt"] / 3.0
+# ... and the largest tolerance that still means one: beyond it any single value would pass
+MISFIT_TOLERANCE_MAX_KT = 50.0
 # Grid of the structure misfit, kt: fine enough that the largest departure between the flown
 # ends is not missed (the correction table's coarser grid keeps the refusal rule unchanged)
 MISFIT_STEP_KT = 1.0
@@ -135,7 +158,7 @@ class ParameterRecommendation:
 
 
 def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DATA,
-              **noise):
+              misfit_tolerance_kt=None, log_parameters=None, **noise):
     """The airspeed parameter for `autopilot` from `flight`, or a refusal.
 
     Parameters
@@ -148,6 +171,12 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
         Parameter name (default ``ARSPD_RATIO`` / ``ASPD_SCALE_1``).
     air : {"compressible", "incompressible"}
         Passed to `identify` (a flight without static pressure is fitted incompressible).
+    misfit_tolerance_kt : float, optional
+        The structure misfit above which one value is refused, kt (default
+        `MISFIT_TOLERANCE_KT`).
+    log_parameters : dict, optional
+        The log's parameters by name (PX4: ``SENS_EN_SDP3X``, ``CAL_AIR_CMODEL``, ...): a
+        warning when PX4 scales a compensated IAS (`px4_sensor_note`).
     **noise
         `identify`'s noise keywords, passed on: ``gps_noise_std_mps``, ``gps_error_sigma_mps``,
         ``gps_error_tau_s``.
@@ -168,6 +197,8 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
         raise PitotcalError(f"no airspeed parameter for autopilot {autopilot!r}: the flight "
                             "must come from an ArduPilot or PX4 log (or its converted CSV)")
     name = name or PARAMETER[autopilot]
+    tolerance = (MISFIT_TOLERANCE_KT if misfit_tolerance_kt is None else
+                 check_misfit_tolerance(misfit_tolerance_kt))
     spread = track_spread_deg(flight.gps_vn_mps, flight.gps_ve_mps)
     if spread < MIN_TRACK_SPREAD_DEG:
         raise PitotcalError(f"no parameter recommended: the track turned through only "
@@ -184,13 +215,12 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
     k1, k1_sd = const.value("k1"), const.stddev("k1")
     value = _parameter(autopilot, k1, qref, air)
     misfit = _misfit(autopilot, value, const, fits, air)
-    for model, d in departures.items():
-        if d["max_departure_kt"] > d["two_sigma_kt"]:
-            raise ParameterRefused(
-                f"no parameter recommended: the {model} model departs from one scale by "
-                f"{d['max_departure_kt']:.2f} kt at {d['vi_kt']:.0f} KIAS (its 2 sigma "
-                f"{d['two_sigma_kt']:.2f} kt): a single {name} cannot represent the error "
-                f"over the flown range ({_misfit_brief(misfit)})", misfit)
+    notes += [n for n in (_judge_misfit(name, misfit, departures, tolerance),) if n]
+    if autopilot == "PX4":
+        sensor = px4_sensor_note(log_parameters or {}, flight)
+        if sensor:
+            warnings.warn(sensor, stacklevel=2)
+            notes.append(sensor)
     grad = gradient(lambda k: _parameter(autopilot, k[0], qref, air), [k1])
     two_sigma = 2.0 * float(band(grad, np.array([[k1_sd ** 2]])))
     _check_bounds(name, value, two_sigma, current, autopilot)
@@ -199,6 +229,67 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
                      "significant, keeping the current value is as good")
     return ParameterRecommendation(autopilot, name, value, two_sigma, current, k1, 2 * k1_sd,
                                    qref, air, spread, departures, tuple(notes), misfit)
+
+
+# PX4 CAL_AIR_CMODEL values whose SDP3x flow model `px4_sensor_note` evaluates
+_PX4_FLOW_MODELS = {0: "model with pitot", 1: "model without pitot"}
+
+
+def px4_sensor_note(log_parameters, flight):
+    """A warning (str) when the log's PX4 scales an IAS its SDP3x compensation has changed, else
+    None (module docstring); the factor IAS_PX4 / sqrt(2 Δp/ρ₀) at the median q_ci flown."""
+    if not log_parameters.get("SENS_EN_SDP3X"):
+        return None
+    cmodel = int(log_parameters.get("CAL_AIR_CMODEL", 0))
+    tube_m = float(log_parameters.get("CAL_AIR_TUBELEN", 0.2))
+    text = (f"PX4 applies ASPD_SCALE to an IAS that already includes its SDP3x compensation "
+            f"(SENS_EN_SDP3X set, CAL_AIR_CMODEL {cmodel}); the scale here is relative to "
+            "sqrt(2 dp/rho0) without it")
+    if cmodel not in _PX4_FLOW_MODELS:
+        return text + ": check the scale against PX4's own IAS before loading it"
+    qci = float(np.median(flight.qci_pa))
+    ps = float(np.median(flight.ps_pa)) if flight.ps_pa is not None else 101325.0
+    rho = float(np.median(flight.rho_kgm3))
+    factor = _sdp3x_ias(qci, ps, rho, tube_m, cmodel == 0) / np.sqrt(2 * qci / RHO0_KGM3)
+    return (text + f": at the median dp flown ({qci:.0f} Pa) PX4's {_PX4_FLOW_MODELS[cmodel]} "
+            f"raises IAS by a factor {factor:.4f}, so load about the value written / "
+            f"{factor:.4f}")
+
+
+def _sdp3x_ias(dp_pa, ps_pa, rho_kgm3, tube_m, pitot):
+    """PX4's compensated IAS of an SDP3x (calc_IAS_corrected, CAL_AIR_CMODEL 0 or 1), m/s."""
+    dp_corr = dp_pa * 96600.0 / ps_pa
+    flow = max((300.805 - 300.878 / (0.00344205 * dp_corr ** 0.68698 + 1.0)) * 1.29 / rho_kgm3,
+               0.0)
+    dp_pitot = (0.0032 * flow ** 2 + 0.0123 * flow + 1.0) * 1.29 / rho_kgm3 if pitot else 0.0
+    dp_tube = flow * 0.674 / 450.0 * tube_m * rho_kgm3 / 1.29
+    return np.sqrt(2.0 * (dp_corr + dp_tube + dp_pitot) / RHO0_KGM3) + 0.125 * flow
+
+
+def check_misfit_tolerance(misfit_tolerance_kt):
+    """`misfit_tolerance_kt` checked: above 0, at most `MISFIT_TOLERANCE_MAX_KT` kt."""
+    return number("misfit_tolerance_kt", misfit_tolerance_kt, 0.0, MISFIT_TOLERANCE_MAX_KT,
+                  lo_open=True)
+
+
+def _judge_misfit(name, misfit, departures, tolerance):
+    """The note stating the structure misfit of one value, or a `ParameterRefused` when it is
+    beyond `tolerance` and its model departs beyond its own 2σ (module docstring)."""
+    if misfit is None:            # no two-coefficient model: its notes say so
+        return None
+    significant = [m for m, d in departures.items() if d["max_departure_kt"] > d["two_sigma_kt"]]
+    if significant and misfit["max_dv_kt"] > tolerance:
+        d = departures[significant[0]]
+        raise ParameterRefused(
+            f"no parameter recommended: the {significant[0]} model departs from one scale by "
+            f"{d['max_departure_kt']:.2f} kt at {d['vi_kt']:.0f} KIAS (its 2 sigma "
+            f"{d['two_sigma_kt']:.2f} kt): a single {name} cannot represent the error "
+            f"over the flown range ({_misfit_brief(misfit)}; more than the tolerance "
+            f"`misfit_tolerance_kt` {tolerance:.2f} kt)", misfit)
+    return (f"one {name} accepted: its structure misfit {misfit['max_dv_kt']:.2f} kt "
+            + (f"is within the tolerance {tolerance:.2f} kt" if misfit["max_dv_kt"] <= tolerance
+               else f"exceeds the tolerance {tolerance:.2f} kt but lies inside its own 2 sigma: "
+               "not established by this flight"))
 
 
 def _parameter(autopilot, k1, qci_pa, air_data):

@@ -21,7 +21,7 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.io.atomic import atomic_open, atomic_path
 
 from . import compliance as comp
-from .aircraft_file import AIRCRAFT_FIELDS, read_aircraft
+from .aircraft_file import AIRCRAFT_FIELDS, aircraft_rule, read_aircraft
 from .budget_tables import budget_report
 from .conditions import turbulence_text
 
@@ -46,7 +46,8 @@ def _fmt(x, spec):
 
 
 def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
-                 speed_range_kt=None, inputs=(), options=None, ident=None):
+                 speed_range_kt=None, inputs=(), options=None, ident=None,
+                 configuration=None, speeds_kcas=None):
     """Everything the report template shows, as a plain dict.
 
     Parameters
@@ -57,7 +58,7 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         The flight the result came from: test conditions, and with `ident` the figures of the fit.
     aircraft_rows : sequence of (label, text)
         The title block (`read_aircraft`).
-    regulation, speed_range_kt
+    regulation, speed_range_kt, configuration, speeds_kcas
         Passed to `compliance.assess`.
     inputs : sequence of (role, path)
         Files whose SHA-256 the provenance lists.
@@ -75,7 +76,8 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
 
     from . import figures as figs
 
-    block = comp.assess(result, regulation, speed_range_kt)
+    block = comp.assess(result, regulation, speed_range_kt, configuration=configuration,
+                        speeds_kcas=speeds_kcas)
     rows = result.get("airspeed_correction") or []
     has_u = bool(rows) and all(r.get("dv_U_kt") is not None for r in rows)
     warnings = list(result.get("warnings", []))
@@ -301,12 +303,13 @@ _READING_OPTIONS = ("start_s", "end_s", "oat_k", "temp_recovery", "rh_pct")
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
                 aircraft_path=None,
                 regulation="23.1323", speed_range_kt=None, json_path=None, pdf_path=None,
-                options=None):
+                options=None, configuration=None):
     """Read the inputs, write the HTML report (and the JSON / PDF when asked).
 
     `flight_options` are the reading identify used: start_s, end_s, oat_k, temp_recovery,
     rh_pct (`pitotcal.io.read_flight`, which makes the air data); those not given (None) come
-    from the result's `reading`. The re-fit takes the result's model, air-data mode (`air_data`;
+    from the result's `reading`. `configuration` (the configuration flown) overrides the
+    aircraft file's; the file's stall speeds set the verdict's speed ranges (`aircraft_rule`). The re-fit takes the result's model, air-data mode (`air_data`;
     "incompressible" when it records none), GPS noise and stated GPS error (`gps_error`).
 
     Returns
@@ -334,13 +337,15 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
                          gps_error_sigma_mps=stated.get("sigma_mps"),
                          gps_error_tau_s=stated.get("tau_s"))
         inputs.append(("Flight", flight_path))
-    rows = ()
+    rows, rule = (), {"configuration": None, "speeds_kcas": {}}
     if aircraft_path is not None:
         rows = read_aircraft(aircraft_path)
+        rule = aircraft_rule(aircraft_path)
         inputs.append(("Aircraft file", aircraft_path))
     context = build_report(result, flight=flight, aircraft_rows=rows, regulation=regulation,
                            speed_range_kt=speed_range_kt, inputs=inputs, options=options,
-                           ident=ident)
+                           ident=ident, configuration=configuration or rule["configuration"],
+                           speeds_kcas=rule["speeds_kcas"])
     html = render_html(context)
     with atomic_open(html_path, "w", encoding="utf-8") as fh:
         fh.write(html)

@@ -79,7 +79,8 @@ def correction_png(result, compliance=None):
 
 
 def altimeter_png(result, compliance=None):
-    """ΔH_pc vs V_i with its 2σ and ± the altimeter limit; None without dh_ft."""
+    """ΔH_pc vs V_i at the test altitude with its 2σ, at sea level, and ± the altimeter limit
+    where it is judged; None without dh_ft."""
     rows = [r for r in result["airspeed_correction"] if r.get("dh_ft") is not None]
     if not rows:
         return None
@@ -88,14 +89,22 @@ def altimeter_png(result, compliance=None):
     ax = fig.subplots()
     if np.isfinite(band).all():
         ax.fill_between(vi, dh - band, dh + band, color="tab:green", alpha=0.3, label="2σ")
-    ax.plot(vi, dh, color="tab:green", lw=2, label="ΔH_pc")
+    ax.plot(vi, dh, color="tab:green", lw=2, label="ΔH_pc at the test altitude")
     if compliance and compliance.get("altimeter", {}).get("rows"):
-        lim = [r for r in compliance["altimeter"]["rows"] if r.get("dh_ft") is not None]
         # the compliance rows are by KCAS: drawn at the KIAS of the same table row
-        lv, ll = np.interp(_column(lim, "vc_kt"), _column(rows, "vc_kt"), vi), \
-            _column(lim, "limit_ft")
-        ax.plot(lv, ll, "r--", lw=1, label="limit, ±30 ft per 100 kt")
-        ax.plot(lv, -ll, "r--", lw=1)
+        def at_vi(sel):
+            return np.interp(_column(sel, "vc_kt"), _column(rows, "vc_kt"), vi)
+
+        alt = compliance["altimeter"]["rows"]
+        sea = [r for r in alt if r.get("dh_ft") is not None]
+        if sea:
+            ax.plot(at_vi(sea), _column(sea, "dh_ft"), color="tab:blue", lw=1.5,
+                    label="ΔH_pc at sea level (judged)")
+        lim = [r for r in alt if r.get("limit_ft") is not None]
+        if lim:
+            lv, ll = at_vi(lim), _column(lim, "limit_ft")
+            ax.plot(lv, ll, "r--", lw=1, label="limit, ±30 ft per 100 kt, at least ±30 ft")
+            ax.plot(lv, -ll, "r--", lw=1)
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set(xlabel=VI_LABEL, ylabel="ΔH_pc (ft)", title="Altimeter correction")
     ax.legend(fontsize=8, loc="best")

@@ -142,7 +142,7 @@ def _first_order(hidden):
         return ""
     return (f" (to first order at {len(speeds)} of the table's speeds, "
             f"{min(speeds):.0f}-{max(speeds):.0f} kt, where it puts q_c beyond the "
-            "subsonic range)")
+            "Mach range of the pitot relations)")
 
 
 def _scan(jac, r, qci, first, threshold):
@@ -206,7 +206,7 @@ def _dv_shift_kt(model, k_shifted, vi_kt, dv_fit_kt, first_order_kt, air_data):
     """(|ΔV shift|, kt, and where it is first order): the shifted calibration's ΔV against
     the fit's at each speed where it exists (`delta_v_kt_where_defined`), the first-order
     shift `first_order_kt` where it does not (a missed step large enough to push q_c past the
-    subsonic range is hidden all the same, and is not a reason to refuse the flight)."""
+    pitot relations' Mach range is hidden all the same, and is not a reason to refuse the flight)."""
     dv = np.abs(dv_fit_kt - delta_v_kt_where_defined(model, k_shifted, vi_kt, air_data))
     linear = ~np.isfinite(dv)
     dv[linear] = np.abs(first_order_kt[linear])
@@ -263,7 +263,7 @@ def _undetected(result, model, onsets, scan, z_detect):
                 "vi_kt": float(vi[j]), "k_shift_sigma": k_sigma,
                 # the band printed in the result's table at that speed (the warning's ratio)
                 "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"]),
-                # speeds where the shifted calibration has no V_c (beyond the subsonic
-                # range): its shift there is the first-order one
+                # speeds where the shifted calibration has no V_c (beyond the Mach
+                # range of the pitot relations): its shift there is the first-order one
                 "first_order_vi_kt": [float(v) for v in vi[linear]]})
     return best[1]

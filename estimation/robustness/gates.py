@@ -12,7 +12,7 @@ import numpy as np
 
 from pitotcal.core.information import normal_isf
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
-from pitotcal.core.units import G0_MPS2, isa_density_kgm3
+from pitotcal.core.units import G0_MPS2, ISA_TOP_M, isa_density_kgm3
 from pitotcal.io.flight_checks import PLAUSIBLE
 
 __all__ = ["DENSITY_MARGIN", "FALSE_TRIM_RATE", "MAX_ACCEL_G", "MAX_TRIM_FRACTION",
@@ -72,7 +72,8 @@ def _density_gate(flight, skip):
     alt = flight.alt_m
     ok = ~skip & np.isfinite(rho)
     if alt is not None and alt.shape == rho.shape and np.isfinite(alt[ok]).any():
-        ref = isa_density_kgm3(np.clip(np.nan_to_num(alt, nan=np.nanmedian(alt[ok])), -1000, 2e4))
+        ref = isa_density_kgm3(np.clip(np.nan_to_num(alt, nan=np.nanmedian(alt[ok])), -1000,
+                                       ISA_TOP_M))
         where = "ISA at the flight's altitude"
     else:
         ref = np.full_like(rho, np.median(rho[ok]) if ok.any() else 1.0)

@@ -21,7 +21,7 @@ from pitotcal.core.checks import (
 )
 from pitotcal.core.dynamics import Limits
 from pitotcal.core.errors import PitotcalError, PlanInfeasibleError
-from pitotcal.core.plan import PROFILES
+from pitotcal.core.plan import ALTITUDE_RANGE_M, PROFILES
 from pitotcal.core.scenario import T2_PLAN
 from pitotcal.core.airdata import A0_MPS
 from pitotcal.core.units import KT_TO_MPS, kt_to_mps
@@ -102,7 +102,8 @@ class PlanRequest:
         Radius of the test area around its centre; the ground track stays inside it at every
         node in the given wind.
     altitude_m : float
-        Constant plan altitude, -400 to 11,000 m (ISA density there gives TAS from CAS).
+        Constant plan altitude, -400 to 32,000 m (`ALTITUDE_RANGE_M`; the ISA there gives
+        TAS from CAS).
     duration_s, bank_max_deg : float
         Maneuver length, s (at most MAX_DURATION_S); bank limit, degrees (0-75).
     wind_speed_mps, wind_from_deg : float
@@ -161,7 +162,7 @@ class PlanRequest:
 
 def _checked_fields(r):
     """{field: checked value} of `PlanRequest` `r` (PitotcalError naming the field)."""
-    # the planner's air data are subsonic: CAS below a0 (Mach 1 at sea level, 661 kt)
+    # CAS below a0 (661 kt, Mach 1 at sea level): the fastest a calibration plan is made for
     cas_min_kt, cas_max_kt = (number(name, value, 0.0, CAS_MAX_KT, lo_open=True, hi_open=True)
                               for name, value in (("cas_min_kt", r.cas_min_kt),
                                                   ("cas_max_kt", r.cas_max_kt)))
@@ -178,7 +179,7 @@ def _checked_fields(r):
     return dict(
         profile=choice("profile", r.profile, PROFILES), cas_min_kt=cas_min_kt,
         cas_max_kt=cas_max_kt, radius_m=radius_m,
-        altitude_m=number("altitude_m", r.altitude_m, -400.0, 11000.0), duration_s=duration_s,
+        altitude_m=number("altitude_m", r.altitude_m, *ALTITUDE_RANGE_M), duration_s=duration_s,
         bank_max_deg=number("bank_max_deg", r.bank_max_deg, 0.0, 75.0, lo_open=True),
         wind_speed_mps=number("wind_speed_mps", r.wind_speed_mps, 0.0),
         wind_from_deg=number("wind_from_deg", r.wind_from_deg, 0.0, 360.0, hi_open=True),

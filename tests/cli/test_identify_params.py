@@ -41,15 +41,23 @@ def test_the_structure_misfit_is_printed_written_and_recorded(tmp_path, capsys):
 def test_a_refusal_is_recorded_with_its_misfit(tmp_path, capsys):
     import json
 
+    # a 0.57 kt misfit, beyond its 2 sigma: recommended under the default 1.67 kt tolerance,
+    # refused under --misfit-tolerance-kt 0.3 (the message names the flag)
     flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -40.0))[0]
     path, rec = tmp_path / "f.csv", tmp_path / "r.json"
     write_flight_csv(flight, path, comments={"autopilot_ARSPD_RATIO": "1.9936"})
-    assert main(["identify", str(path), "--params", str(tmp_path / "p.param"), "--json",
-                 str(rec), "--no-budget"]) == 2
+    args = ["identify", str(path), "--params", str(tmp_path / "p.param"), "--json", str(rec),
+            "--no-budget"]
+    assert main(args) == 0
+    record = json.loads(rec.read_text())["autopilot_parameter"]
+    assert record["structure_misfit"]["max_dv_kt"] == pytest.approx(0.57, abs=0.05)
+    assert "within the tolerance 1.67 kt" in capsys.readouterr().out
+    assert main([*args, "--misfit-tolerance-kt", "0.3"]) == 2
     record = json.loads(rec.read_text())["autopilot_parameter"]
     assert record["refused"].startswith("no parameter recommended: ")
     assert record["structure_misfit"]["max_dv_kt"] > 0.3
-    assert "kt at" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "kt at" in err and "--misfit-tolerance-kt 0.30 kt" in err
 
 
 def test_csv_without_autopilot_is_refused(flight, tmp_path, capsys):

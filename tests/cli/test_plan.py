@@ -56,7 +56,7 @@ REFUSALS = [
     # item 7 of issue 8: 400 was silently planned as 040°
     (["--wind-from-deg", "400"], "--wind-from-deg 400 must be >= 0 and < 360"),
     (["--cas-min-kt", "-5"], "--cas-min-kt -5 must be > 0"),
-    (["--altitude-m", "20000"], "--altitude-m 20000 must be >= -400 and <= 11000"),
+    (["--altitude-m", "40000"], "--altitude-m 40000 must be >= -400 and <= 32000"),   # the ISA
     (["--bank-max-deg", "90"], "--bank-max-deg 90 must be > 0 and <= 75"),
     (["--roll-rate-max-dps", "0"], "--roll-rate-max-dps 0 must be > 0"),
     (["--accel-max-mps2", "nan"], "--accel-max-mps2 nan must be a finite number"),

@@ -132,7 +132,7 @@ def test_a_plan_beyond_what_plan_makes_is_refused_before_flying(tmp_path, plan_c
     assert main(["simulate", str(bad), "-o", str(tmp_path / "f.csv")]) == 2
     err = capsys.readouterr().err.strip()
     assert err == (f"pitotcal simulate: {bad}: column alt_m, row 3 (line {header + 4}): 1e+06 "
-                   "is outside -400 to 11000 m (what a plan can hold)")
+                   "is outside -400 to 32000 m (what a plan can hold)")
     assert not (tmp_path / "f.csv").exists() and not (tmp_path / "f.truth.json").exists()
 
 

@@ -71,7 +71,7 @@ HEADER = "point,ias_kt,pressure_alt_ft,oat_c,groundspeed_kt,track_deg\n"
     (HEADER + "1,100,3000,290,95,0\n", "looks like kelvin"),
     (HEADER + "1,100,3000,10,95,400\n", r"column track_deg, row 1 \(line 2\): 400 is outside"),
     (HEADER + "1,100,3000,10,nan,0\n", "not a finite number"),
-    (HEADER + "1,100,50000,10,95,0\n", "ISA troposphere"),
+    (HEADER + "1,100,110000,10,95,0\n", r"the ISA, -2,000 ft to 32 km"),
     (HEADER + ",100,3000,10,95,0\n", r"column point, row 1 \(line 2\): empty"),
     (HEADER + "1,100,3000,10,190,0\n1,100,3000,10,200,90\n", "in km/h"),
     (HEADER + "1,100,3000,10,50,0\n1,100,3000,10,55,90\n", "in m/s"),

@@ -45,6 +45,11 @@ def add_parser(subparsers):
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
     add_reading_arguments(p)
+    p.add_argument("--columns", metavar="MAP.toml", default=None,
+                   help="read FLIGHT as any CSV export through this column mapping (TOML: "
+                        "which column is time, GPS velocity, total or impact pressure, static "
+                        "pressure, total or static temperature, GPS height, each with its unit; "
+                        "docs/interfaces.md section 1b)")
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
@@ -57,6 +62,12 @@ def add_parser(subparsers):
                         "has ({px4_params}; {px4_param} when it has neither); the current "
                         "value and the 2-sigma as comments; exit 2 with the reason when the "
                         "flight cannot support one")
+    g.add_argument("--misfit-tolerance-kt", dest="misfit_tolerance_kt", type=float,
+                   default=None, metavar="KT",
+                   help="with --params: refuse a single value only when its structure misfit "
+                        "(the largest error of one value over the flown range against the "
+                        "two-coefficient fit, when that departure is beyond its 2-sigma) exceeds "
+                        "KT (default {misfit_kt:.2f}, a third of the 5 kt airspeed limit)")
     live = p.add_argument_group("live (a MAVLink stream instead of FLIGHT)")
     live.add_argument("--live", metavar="CONNECTION", default=None,
                       help="re-identify the growing maneuver every second from a MAVLink "
@@ -125,6 +136,7 @@ def _help_constants():
     import dataclasses
 
     from pitotcal.estimation.identification import budget
+    from pitotcal.estimation.reporting.autopilot_params import MISFIT_TOLERANCE_KT
     from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
     from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
@@ -133,6 +145,7 @@ def _help_constants():
             "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
             "budget_solves": 2 * len(budget.SOURCES), "ardupilot_param": ARDUPILOT_RATIO,
             "px4_params": " or ".join(PX4_SCALES), "px4_param": PX4_SCALES[0],
+            "misfit_kt": MISFIT_TOLERANCE_KT,
             "idle_s": IDLE_TIMEOUT_S}
 
 
@@ -170,6 +183,10 @@ def run(args):
     # the live options are checked with a file too: a NaN is no option anywhere
     idle_timeout_s(args.idle_s)
     positive("target_2sigma_kt", args.target_2sigma_kt)
+    if args.misfit_tolerance_kt is not None:
+        from pitotcal.estimation.reporting.autopilot_params import check_misfit_tolerance
+
+        check_misfit_tolerance(args.misfit_tolerance_kt)
     if args.live is not None or args.flight is None:
         return _run_live(args)
     import warnings
@@ -245,7 +262,11 @@ def _read(args, source):
     air = {"oat_k": oat_k_from_c(args.oat_c), "temp_recovery": args.temp_recovery,
            "rh_pct": args.rh_percent}
     if args.params is None:
-        return read_flight(source, start_s=args.start_s, end_s=args.end_s, **air), None, {}
+        return read_flight(source, start_s=args.start_s, end_s=args.end_s,
+                           columns=getattr(args, "columns", None), **air), None, {}
+    if getattr(args, "columns", None) is not None:
+        raise PitotcalError("--params reads an autopilot log; --columns maps a CSV export: "
+                            "give one of them", param="columns")
     from pitotcal.io.param_files import read_flight_and_parameters
     flight, autopilot, current = read_flight_and_parameters(source, args.start_s, args.end_s,
                                                             **air)
@@ -291,7 +312,8 @@ def _write_params(args, flight, autopilot, current):
     default = autopilot_params.PARAMETER.get(autopilot, "")
     rec = autopilot_params.recommend(flight, autopilot, current.get(name or default),
                                      gps_noise_std_mps=args.gps_noise_mps, name=name,
-                                     air=args.air, **_gps_error(args))
+                                     air=args.air, misfit_tolerance_kt=args.misfit_tolerance_kt,
+                                     log_parameters=current, **_gps_error(args))
     autopilot_params.write_parameter_file(rec, args.params)
     return rec
 

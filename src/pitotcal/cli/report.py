@@ -7,6 +7,8 @@ stderr line naming the file or flag.
 from pathlib import Path
 
 REGULATION_CHOICES = ("23.1323", "25.1323", "none")
+# the configurations the compliance verdict knows (flaps retracted for cruise)
+CONFIGURATIONS = ("cruise", "takeoff", "approach", "landing")
 
 
 def add_parser(subparsers):
@@ -32,7 +34,12 @@ def add_parser(subparsers):
                    help="with --flight: the relative humidity identify used, %%")
     p.add_argument("--aircraft", metavar="AIRCRAFT.toml", default=None,
                    help="title block: [aircraft] type, registration, configuration, weight, cg; "
-                        "[test] date, location, pilot, engineer, notes")
+                        "[test] date, location, pilot, engineer, notes; the stall and limit "
+                        "speeds vs0_kcas, vs1_kcas (Part 23), vsr0_kcas, vsr1_kcas (Part 25), "
+                        "vfe_kcas, vmo_kcas, vne_kcas set the verdict's speed ranges")
+    p.add_argument("--configuration", default=None, choices=CONFIGURATIONS,
+                   help="the configuration flown (overrides the aircraft file's): picks the "
+                        "airspeed paragraph's speed range (cruise: flaps retracted)")
     p.add_argument("--regulation", default=REGULATION_CHOICES[0], metavar="R",
                    help=f"{', '.join(REGULATION_CHOICES[:-1])} or {REGULATION_CHOICES[-1]} "
                         "(default %(default)s)")
@@ -76,14 +83,23 @@ def run(args):
     done = make_report(source, args.output, flight_path=args.flight, flight_options=read,
                        aircraft_path=args.aircraft, regulation=args.regulation,
                        speed_range_kt=args.speed_range_kt, json_path=args.json,
-                       pdf_path=args.pdf, options=options)
+                       pdf_path=args.pdf, options=options, configuration=args.configuration)
     block = done["compliance"]
     if block.get("verdict"):
         print(f"Compliance ({args.regulation}): {block['verdict']}, "
               f"{block['speed_range_kt'][0]:.1f}-{block['speed_range_kt'][1]:.1f} KCAS "
               f"({block['speed_range_source']} range; {block['uncertainty']} uncertainty): "
               f"airspeed {block['airspeed']['verdict']}, "
-              f"altimeter {block['altimeter']['verdict']}")
+              f"altimeter {block['altimeter']['verdict']} over {_range(block['altimeter'])}; "
+              f"configuration {block['configuration'] or 'not stated'}")
     for path in done["written"]:
         print(f"Wrote {path}")
     return 0
+
+
+def _range(check):
+    """The speed range a check was judged over, in words."""
+    w = check.get("window") or {}
+    if w.get("lo_kt") is None:
+        return "no speed range"
+    return f"{w['lo_kt']:.1f}-{w['hi_kt']:.1f} KCAS"

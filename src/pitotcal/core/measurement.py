@@ -42,12 +42,10 @@ from .gps_velocity import estimate_gps_noise_std, interpolate_held
 from .models import qci_from_qc_pa
 from .scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from .units import (
-    ISA_EXPONENT,
-    ISA_P0_PA,
-    ISA_T0_K,
     R_AIR_JKGK,
     isa_density_kgm3,
     isa_pressure_pa,
+    isa_state_of_density,
     isa_temperature_k,
 )
 
@@ -56,12 +54,14 @@ __all__ = [
     "AIR_DATA_MODES",
     "Channels",
     "DEFAULT_AIR_DATA",
+    "INCOMPRESSIBLE_MACH_MAX",
     "IncompressibleAir",
     "StaticAir",
     "TotalPressureAir",
     "as_air",
     "flight_air",
     "flight_channels",
+    "flight_mach",
     "impact_pressure_pa",
     "isa_air",
     "isa_air_of_density",
@@ -71,6 +71,10 @@ __all__ = [
     "sensitivities",
     "tas_squared",
 ]
+
+# Above this Mach number the incompressible relation q_c = ½ρV_t² is short of the impact
+# pressure by more than M²/4 = 2.25 %: an incompressible fit is then warned about.
+INCOMPRESSIBLE_MACH_MAX = 0.3
 
 # The flight's data channels of each air-data type (`flight_air`), by the estimator's mode:
 # "reference" is the compressible fit from an independent reference static pressure.
@@ -245,6 +249,22 @@ def flight_air(flight, air_data=DEFAULT_AIR_DATA):
     return StaticAir(np.asarray(flight.ps_ref_pa, float), oat)
 
 
+def flight_mach(flight, wind_n_mps, wind_e_mps):
+    """The true Mach number of each sample of `flight`, ndarray (N,).
+
+    V_t from the GPS ground velocity less the air-mass velocity (`tas_squared`, the vertical
+    speed included when logged); the speed of sound from the flight's `oat_k`, or without it
+    from the ISA temperature of its density (`isa_state_of_density`). NaN where the
+    temperature is not positive.
+    """
+    vd_sq = None if flight.gps_vd_mps is None else np.asarray(flight.gps_vd_mps, float) ** 2
+    tas_sq = tas_squared(np.asarray(flight.gps_vn_mps, float), np.asarray(flight.gps_ve_mps, float),
+                         wind_n_mps, wind_e_mps, vd_sq)
+    oat = flight.oat_k if flight.oat_k is not None else isa_state_of_density(flight.rho_kgm3)[1]
+    with np.errstate(invalid="ignore", divide="ignore"):     # a bad cell gives NaN there
+        return np.sqrt(tas_sq) / airdata.speed_of_sound_mps(np.asarray(oat, float))
+
+
 def isa_air(alt_m, air_data=DEFAULT_AIR_DATA, oat_k=None):
     """The ISA air at geopotential altitude `alt_m` (m): `IncompressibleAir` of the density
     p/(R T) or `StaticAir` (p, T); `oat_k` replaces the ISA temperature when given (the
@@ -259,7 +279,8 @@ def isa_air(alt_m, air_data=DEFAULT_AIR_DATA, oat_k=None):
 
 def isa_air_of_density(rho_kgm3, air_data=DEFAULT_AIR_DATA):
     """The ISA air of density ρ (kg/m³): `IncompressibleAir` (ρ) or `StaticAir` at the ISA
-    troposphere state of that density, T = T₀ (ρ/ρ₀)^(1/(n − 1)), p = ρ R T, n = g₀/(R L).
+    state of that density (`pitotcal.core.units.isa_state_of_density`: in the troposphere
+    T = T₀ (ρ/ρ₀)^(1/(n − 1)), p = ρ R T, n = g₀/(R L); the layers above to 32 km likewise).
 
     For callers that carry only a density (the design's schedules): the compressible relation
     then needs the pressure and temperature that go with it.
@@ -267,9 +288,7 @@ def isa_air_of_density(rho_kgm3, air_data=DEFAULT_AIR_DATA):
     rho = np.asarray(rho_kgm3, float)
     if air_data == "incompressible":
         return IncompressibleAir(rho)
-    rho0 = ISA_P0_PA / (R_AIR_JKGK * ISA_T0_K)
-    oat = ISA_T0_K * (rho / rho0) ** (1.0 / (ISA_EXPONENT - 1.0))
-    return StaticAir(rho * R_AIR_JKGK * oat, oat)
+    return StaticAir(*isa_state_of_density(rho))
 
 
 @dataclass(frozen=True)

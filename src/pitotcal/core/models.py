@@ -121,7 +121,7 @@ def delta_v_kt_where_defined(model, k, vi_kt, air_data="incompressible"):
     """`delta_v_kt` at the speeds where it exists, NaN elsewhere.
 
     A calibration far from the fitted one (a diagnostic's shifted coefficients) can have
-    1 - f(q_ci) <= 0 or a true q_c beyond the subsonic range at some indicated speeds: there
+    1 - f(q_ci) <= 0 or a true q_c beyond the Mach range of the pitot relations at some indicated speeds: there
     is no V_c, and the diagnostic asking must say so rather than stop the identification.
     """
     vi_mps = kt_to_mps(np.asarray(vi_kt, dtype=float))
@@ -131,7 +131,7 @@ def delta_v_kt_where_defined(model, k, vi_kt, air_data="incompressible"):
         qc = qc_from_qci_pa(model, k, qci)
     ok = np.isfinite(qc) & (qc >= 0.0)
     if air_data == "compressible":
-        ok &= qc <= airdata.QC_SONIC_PA
+        ok &= qc <= airdata.QC_MAX_PA
     out = np.full(np.shape(qc), np.nan)
     out[ok] = mps_to_kt(airspeed_of(qc[ok]) - vi_mps[ok])
     return out

@@ -1,6 +1,6 @@
 """Temperature and humidity inputs of the air data: total to static temperature, moist air.
 
-    T_s  = T_t / (1 + r 0.2 M²),   M from q_ci / p_s            (static from total temperature)
+    T_s  = T_t / (1 + r 0.2 M²)                                 (static from total temperature)
     e_s  = 610.94 exp(17.625 t / (t + 243.04)) Pa, t in °C      (saturation over water)
     e    = (RH / 100) e_s(T_s)
     T_v  = T_s / (1 − (e / p_s)(1 − ε)),   ε = R_d / R_v = 0.622 (virtual temperature)
@@ -18,7 +18,10 @@ RH. γ is taken as 1.4 for moist air too (the change is below 0.1 %).
 `with_static_air` turns a `Flight` with these columns into the Flight the estimator needs:
 `oat_k` the static temperature (virtual when humid: the compressible relations take it for
 both the density and the speed of sound) and `rho_kgm3` = p_s / (R T_v), once, when
-`pitotcal.io.read_flight` reads the flight.
+`pitotcal.io.read_flight` reads the flight. M is then the indicated Mach (q_ci / p_s,ind): the
+calibration's is not known yet. `identify` makes T_s again at the calibrated (true) Mach
+(`at_mach`) and fits again until T_s settles. A static `oat_k` that rises with airspeed as a
+total temperature does (its ram rise 0.2 M² T) gets a warning (`ram_rise_note`).
 """
 
 import dataclasses
@@ -26,15 +29,17 @@ import warnings
 
 import numpy as np
 
-from .airdata import mach_from_qc
+from .airdata import QC_OVER_PS_MAX, mach_from_qc, pressure_altitude_m
 from .checks import number
 from .errors import FlightDataError, PitotcalError
-from .units import R_AIR_JKGK
+from .units import R_AIR_JKGK, isa_temperature_k
 
 __all__ = [
     "EPSILON",
+    "at_mach",
     "check_air_options",
     "moist_density_kgm3",
+    "ram_rise_note",
     "saturation_vapour_pressure_pa",
     "static_temperature_k",
     "virtual_temperature_k",
@@ -101,6 +106,68 @@ def static_temperature_k(tat_k, qci_pa, ps_pa, recovery=1.0):
     return np.asarray(tat_k, dtype=float) / (1.0 + recovery * 0.2 * mach ** 2)
 
 
+def at_mach(flight, mach):
+    """`flight` with `oat_k` and `rho_kgm3` made again from its `tat_k` at the Mach numbers
+    `mach` (ndarray (N,), the calibration's true Mach of each sample); None when its `oat_k`
+    was not made from `tat_k` by `with_static_air`.
+
+    The humidity `with_static_air` applied is applied again (virtual temperature).
+    """
+    source = flight.meta.get(_OAT_SOURCE, "")
+    if flight.tat_k is None or flight.ps_pa is None or not source.startswith("tat_k"):
+        return None
+    reading = flight.reading or {}
+    recovery = reading.get("temp_recovery")
+    if recovery is None:                    # made in memory: the factor the source names
+        recovery = float(source.rsplit(" ", 1)[-1])
+    t_air = np.asarray(flight.tat_k, float) / (1.0 + recovery * 0.2 * np.asarray(mach) ** 2)
+    if flight.meta.get(_OAT_VIRTUAL) and flight.rh_pct is not None:
+        t_air = virtual_temperature_k(t_air, flight.ps_pa, flight.rh_pct)
+    return dataclasses.replace(flight, oat_k=t_air, rho_kgm3=flight.ps_pa / (R_AIR_JKGK * t_air))
+
+
+# A static oat_k is suspected to be total when it follows at least this fraction of the ram
+# rise 0.2 M² T over a flight whose ram rise spans at least _RAM_SPAN_K.
+_RAM_FRACTION = 0.5
+_RAM_SPAN_K = 2.0
+
+
+def ram_rise_note(flight):
+    """The warning of a static `oat_k` column that rises with airspeed as a total temperature
+    does, or None.
+
+    Regresses oat_k, less the ISA lapse over the flight's pressure altitudes, on the ram rise
+    0.2 M_i² T (M_i from q_ci / p_s): a static temperature has no ram-rise term, a total one
+    a slope near the probe's recovery factor (about 1). Needs `ps_pa` and a ram rise that spans _RAM_SPAN_K
+    over the flight, so at low speed it says nothing.
+    """
+    if flight.oat_k is None or flight.ps_pa is None or flight.n < 10:
+        return None
+    t = np.asarray(flight.oat_k, float)
+    ps = np.asarray(flight.ps_pa, float)
+    ratio = np.clip(np.asarray(flight.qci_pa, float) / ps, 0.0, QC_OVER_PS_MAX)
+    ok = np.isfinite(t) & np.isfinite(ratio) & (ps > 0)
+    if ok.sum() < 10:
+        return None
+    rise = 0.2 * mach_from_qc(ratio[ok] * ps[ok], ps[ok]) ** 2 * t[ok]
+    if np.ptp(np.percentile(rise, [2, 98])) < _RAM_SPAN_K:
+        return None
+    # the standard lapse rate taken out, not fitted: the static port's position error moves
+    # the indicated altitude with the speed, so a fitted altitude term would take the ram rise
+    alt = pressure_altitude_m(np.clip(ps[ok], 870.0, 1.08e5))
+    level = t[ok] - (isa_temperature_k(alt) - isa_temperature_k(np.median(alt)))
+    design = np.column_stack([np.ones(rise.size), rise])
+    slope = float(np.linalg.lstsq(design, level, rcond=None)[0][1])
+    if slope < _RAM_FRACTION:
+        return None
+    return (f"{flight.source}: column oat_k rises with airspeed as a total temperature does "
+            f"(it follows {slope:.2f} of the ram rise 0.2 M² T, which reaches "
+            f"{np.percentile(rise, 98):.1f} K at the top speeds; a static temperature does "
+            "not rise): if it is the probe's total temperature, give it as column tat_k "
+            "(with its recovery factor, `temp_recovery`), or the static temperature is too "
+            "warm by that much")
+
+
 def check_air_options(temp_recovery=1.0, rh_pct=None):
     """(temp_recovery, rh_pct) checked: the recovery factor in [0, 1], the humidity in
     [0, 100] % or None; a PitotcalError naming `temp_recovery` or `rh_percent`."""
@@ -126,7 +193,8 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     Returns
     -------
     Flight
-        `flight` itself when it has neither `tat_k` nor humidity; else a copy with `oat_k`
+        `flight` itself when it has neither `tat_k` nor humidity (a copy with a warning when
+        its static `oat_k` looks total, `ram_rise_note`); else a copy with `oat_k`
         the static temperature — the virtual temperature T_v when a humidity is known
         (`meta["oat_k_is"]` says so), as the compressible relations and the density both
         need it — `rho_kgm3` = p_s / (R T_v), and the humidity used in `rh_pct`. An `oat_k`
@@ -153,6 +221,10 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
                             param="flight")
     tat, oat = flight.tat_k, flight.oat_k
     rh = flight.rh_pct if rh_pct is None else np.full(flight.n, rh_pct)
+    note = ram_rise_note(flight) if oat is not None else None
+    if note:
+        warnings.warn(note, stacklevel=2)
+        flight = dataclasses.replace(flight, warnings=(*flight.warnings, note))
     if tat is None and rh is None:
         return flight
     ps = flight.ps_pa

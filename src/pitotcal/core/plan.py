@@ -20,15 +20,17 @@ PLAN_COLUMNS = ("time_s", "north_m", "east_m", "alt_m", "heading_deg", "bank_deg
 PROFILES = ("continuous", "step-pause", "two-speed")
 TURNS = ("right", "left")
 
-# The altitudes `pitotcal plan` plans for (ISA troposphere, where the air data hold), m.
-ALTITUDE_RANGE_M = (-400.0, 11000.0)
+# The altitudes `pitotcal plan` plans for, m: the ISA where the air data hold, up to the top of
+# its layers (`pitotcal.core.units.ISA_TOP_M`, a test checks they agree; numpy-free here).
+ALTITUDE_RANGE_M = (-400.0, 32000.0)
 # What a plan's columns can hold (a plan CSV read back is checked against these), SI: a test
-# area of at most 100 km, banks the planner allows (<= 75 deg), subsonic airspeeds (the
-# heading is unwrapped, so any finite value).
+# area of at most 100 km, banks the planner allows (<= 75 deg), airspeeds up to the CAS the
+# planner takes (661 kt) and the true airspeed that is at 32 km (the heading is unwrapped,
+# so any finite value).
 PLAN_RANGES = {
     "north_m": (-1e5, 1e5), "east_m": (-1e5, 1e5), "alt_m": ALTITUDE_RANGE_M,
     "bank_deg": (-75.0, 75.0),
-    "tas_mps": (0.0, 300.0), "cas_mps": (0.0, 300.0), "qc_pa": (0.0, 1e5),
+    "tas_mps": (0.0, 1000.0), "cas_mps": (0.0, 350.0), "qc_pa": (0.0, 1e5),
 }
 
 

@@ -12,7 +12,9 @@ V_t sqrt(ρ/ρ₀), is a different speed: at 10,000 ft and 260 KEAS the CAS is 2
 25,000 ft and 250 KEAS 257.3 kt (the compressibility correction grows with Mach and falls
 with p_s); near sea level the two agree to ~0.01 kt at light-aircraft speeds.
 
-Altitudes are checked against the ISA troposphere (`airdata.static_pressure_pa`).
+Above Mach 1 the impact pressure is the Rayleigh pitot law's (`airdata.pitot_pressure_ratio`),
+and a CAS above a₀ (661.5 kt) too. Altitudes are checked against the ISA's range, −2,000 ft to
+32 km (`airdata.static_pressure_pa`).
 """
 
 import numpy as np

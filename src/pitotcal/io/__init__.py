@@ -39,7 +39,8 @@ def is_log_file(path):
     return Path(path).suffix.lower() in LOG_EXTENSIONS
 
 
-def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0, rh_pct=None):
+def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0, rh_pct=None,
+                columns=None):
     """Read a calibration flight from a flight CSV or an autopilot log.
 
     Parameters
@@ -58,6 +59,9 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
         T_s = T_t / (1 + r 0.2 M²) (`pitotcal.core.moist_air.with_static_air`).
     rh_pct : float, optional
         Relative humidity, %, overriding an `rh_pct` column (default: the column, else dry).
+    columns : str or path-like, optional
+        A column mapping (TOML, docs/interfaces.md §1b): `path` is then any CSV export whose
+        columns and units the mapping names (`pitotcal.io.mapped_csv.read_mapped_csv`).
 
     Returns
     -------
@@ -88,6 +92,14 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
     temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
     reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                "temp_recovery": temp_recovery, "rh_pct": rh_pct}
+    if columns is not None:
+        if is_log_file(path) or oat_k is not None:
+            raise PitotcalError(f"columns applies to CSV exports only, without oat_k; "
+                                f"{Path(path).name} is read as it is", param="columns")
+        from .mapped_csv import read_mapped_csv
+        return with_reading(read_mapped_csv(path, columns, start_s, end_s,
+                                            temp_recovery=temp_recovery, rh_pct=rh_pct),
+                            {**reading, "columns": str(columns)})
     with naming(path):
         return _read_flight(read_once(path), reading)
 

@@ -43,7 +43,7 @@ _OPTIONAL = ("duration_s", "groundspeed_sd_kt")
 _RANGES = {
     "ias_kt": (10.0, 600.0, ""),
     "qc_pa": (50.0, 0.89 * airdata.P0_PA, " (hPa or kPa? give pascals)"),
-    "pressure_alt_ft": (-2000.0, 36089.0, " (the ISA troposphere, -2,000 to 36,089 ft)"),
+    "pressure_alt_ft": (-2000.0, 104987.0, " (the ISA, -2,000 ft to 32 km, 104,987 ft)"),
     "oat_c": (-90.0, 60.0, ""),
     "oat_k": (180.0, 330.0, ""),
     "groundspeed_kt": (1.0, 700.0, ""),

@@ -234,6 +234,8 @@ def _read_autopilot_estimates(ulog, t0, s):
         sfield, scale = _first_field(wind, ["tas_scale", "tas_scale_validated", "tas_scale_raw"])
         if scale is not None and np.any(scale > 0):
             s.airspeed_scale[f"{wname}.{sfield} (last)"] = float(scale[scale > 0][-1])
-    for pname in ("ASPD_SCALE", "ASPD_SCALE_1"):
+    # the scale, and the airspeed sensor model PX4 compensates its IAS with before scaling
+    for pname in ("ASPD_SCALE", "ASPD_SCALE_1", "SENS_EN_SDP3X", "CAL_AIR_CMODEL",
+                  "CAL_AIR_TUBELEN", "CAL_AIR_TUBED_MM"):
         if pname in ulog.initial_parameters:
             s.airspeed_scale[pname] = float(ulog.initial_parameters[pname])

@@ -124,3 +124,35 @@ def test_a_term_not_computed_prints_n_a(fitted, budget):
     spoiled = dataclasses.replace(budget, terms_kt=terms)     # u_c and U then NaN too
     text = budget_summary(fitted[1], spoiled)
     assert "nan" not in text and "n/a" in text
+
+
+def test_altimeter_and_mach_terms_follow_the_airspeed_terms(fitted, budget):
+    """Each Type B term carried to ΔH_pc and ΔM_pc: at a fixed V_ic the re-solve moves the
+    static error by δΔp = (dq_c/dV_c) δΔV, so ΔH by δΔp / (ρ_ISA(H_ic) g0) and ΔM by
+    (∂M/∂q_c) δΔp (first order, independent of the budget's products)."""
+    from pitotcal.core import airdata
+    from pitotcal.core.units import G0_MPS2, isa_density_kgm3, kt_to_mps, m_to_ft
+    from pitotcal.estimation.identification.static_source import pressure_altitude_ic_m
+
+    _, result = fitted
+    vc = budget.vi_kt + result.delta_v_kt(budget.vi_kt)[0]
+    dqc_dvc = (airdata.qc_from_cas_pa(kt_to_mps(vc + 0.01))
+               - airdata.qc_from_cas_pa(kt_to_mps(vc - 0.01))) / kt_to_mps(0.02)
+    h_ic = pressure_altitude_ic_m(result)
+    ps = float(np.median(result.ps_pa))
+    qc = airdata.qc_from_cas_pa(kt_to_mps(vc))
+    dm_dqc = (airdata.mach_from_qc(qc + 1.0, ps) - airdata.mach_from_qc(qc - 1.0, ps)) / 2.0
+    for name in ("oat", "humidity", "qc_scale", "qc_offset", "probe_lever_arm"):
+        dp = dqc_dvc * kt_to_mps(budget.terms_kt[name])
+        dh = m_to_ft(dp / (isa_density_kgm3(h_ic) * G0_MPS2))
+        assert budget.products["dh_ft"][name] == pytest.approx(dh, rel=0.03), name
+        assert budget.products["dmach"][name] == pytest.approx(dm_dqc * dp, rel=0.05), name
+    # the combination is the same GUM sum, and the JSON row carries it
+    u = budget.products["dh_ft"]
+    assert budget.product_expanded("dh_ft") == pytest.approx(
+        2 * np.sqrt(sum(t ** 2 for t in u.values())))
+    row = budget.product_row(0)
+    assert row["dh_U_ft"] == pytest.approx(budget.product_expanded("dh_ft")[0])
+    assert set(row["u_dh_by_source_ft"]) == {"statistical", *budget.terms_kt}
+    # 1 K of OAT at ~150 ft: about 0.76 ft of ΔH at 70 kt (ΔV 0.12 kt)
+    assert 0.5 < u["oat"][0] < 1.0

@@ -79,19 +79,21 @@ def test_delta_v_where_defined_is_nan_only_beyond_the_law():
     for air in ("compressible", "incompressible"):
         np.testing.assert_allclose(delta_v_kt_where_defined(model, k, vi, air),
                                    delta_v_kt(model, k, vi, air))
-    # 1 - f(q_ci) near zero: q_c = 100 q_ci, past Mach 1 from 90 kt up (491 kt at 60)
-    far = delta_v_kt_where_defined(model, np.array([0.99, 0.0]), vi, "compressible")
+    # 1 - f(q_ci) near zero: q_c = 1000 q_ci, past Mach 3 (the pitot relations' range, Rayleigh
+    # above Mach 1) from 90 kt up
+    far = delta_v_kt_where_defined(model, np.array([0.999, 0.0]), vi, "compressible")
     assert np.isfinite(far[0]) and np.all(np.isnan(far[1:]))
-    with pytest.raises(pitotcal.PitotcalError, match="subsonic"):
-        delta_v_kt(model, np.array([0.99, 0.0]), vi, "compressible")
+    with pytest.raises(pitotcal.PitotcalError, match="outside the Mach range"):
+        delta_v_kt(model, np.array([0.999, 0.0]), vi, "compressible")
 
 
 def test_static_source_products_beyond_the_law_are_named_not_raised():
     flight, _ = _flight(0, 0.5)
     result = pitotcal.identify(flight)
     # a calibration far out (q_c = 2 q_ci) at a low static pressure: the static error
-    # pushes q_c / p_s past Mach 1 while the airspeed correction exists
-    far = dataclasses.replace(result, ps_pa=np.full_like(result.ps_pa, 4000.0),
+    # pushes q_c / p_s past Mach 3 (the Rayleigh law's range) while the airspeed correction
+    # exists
+    far = dataclasses.replace(result, ps_pa=np.full_like(result.ps_pa, 200.0),
                               internal_params=np.r_[0.5, 0.0, result.internal_params[2:]])
     table = far.correction_table()
     assert any(not np.isfinite(row["dmach"]) for row in table)
@@ -100,15 +102,17 @@ def test_static_source_products_beyond_the_law_are_named_not_raised():
     assert static_source.unavailable_warning(result, result.correction_table()) is None
 
 
-def test_static_products_outside_the_troposphere_have_no_altitude():
+def test_static_products_outside_the_isa_have_no_altitude():
     flight, _ = _flight(0, 0.5)
     result = pitotcal.identify(flight)
-    high = dataclasses.replace(result, ps_pa=np.full_like(result.ps_pa, 15000.0))
+    # 800 Pa: above the ISA's 32 km (868 Pa); 15,000 Pa (13.6 km) was outside it when it ended
+    # at the tropopause
+    high = dataclasses.replace(result, ps_pa=np.full_like(result.ps_pa, 800.0))
     assert static_source.pressure_altitude_ic_m(high) is None
     table = high.correction_table()
     assert all(not np.isfinite(row["dh_ft"]) for row in table)
     assert "dH_pc" in static_source.unavailable_warning(high, table)
-    assert "outside the ISA troposphere" in "\n".join(high.summary().splitlines())
+    assert "outside the ISA (-2,000 ft to 32 km)" in "\n".join(high.summary().splitlines())
 
 
 def test_a_degenerate_monitor_noise_model_is_a_warning_not_a_record_the_monitor_refuses():

@@ -55,7 +55,8 @@ def test_objective_is_the_corrected_score():
 
 def test_graph_size_does_not_grow_with_n():
     model = get_model("inverse")
-    small, large = (objective_function(model, n, False).n_nodes() for n in (10, 1_000_000))
+    # n = 12, not 10: the merged graph shares a constant 10 with 1/n there (one node fewer)
+    small, large = (objective_function(model, n, False).n_nodes() for n in (12, 1_000_000))
     assert small == large < 60
 
 
@@ -142,5 +143,7 @@ def test_spread_weights_are_the_spread_gradient(air_data):
 def test_compressible_graph_size_does_not_grow_with_n():
     model = get_model("inverse")
     small, large = (objective_function(model, n, False, "compressible").n_nodes()
-                    for n in (10, 1_000_000))
-    assert small == large < 80
+                    for n in (12, 1_000_000))
+    # 85 nodes with the Rayleigh branch above Mach 1 (if_else evaluates both branches; 125
+    # before the objective's common subexpressions were merged); 71 when it was isentropic only
+    assert small == large < 90

@@ -2,6 +2,7 @@
 good ones shown as before."""
 
 import json
+import re
 
 import pytest
 from reportfixtures import result_json
@@ -69,3 +70,41 @@ def test_a_known_key_with_a_prefix_or_suffix_is_an_extra_key(tmp_path):
     path.write_text('[aircraft]\nweight_kg = 1050\nserial_no = "S1"\n[test]\ncopilot = "B"\n')
     assert [name for name, _ in read_aircraft(path)] == [
         "aircraft.weight_kg", "aircraft.serial_no", "test.copilot"]
+
+
+@pytest.mark.parametrize("text, message", [
+    ('[aircraft]\nconfiguration = "landng"\n',
+     "key aircraft.configuration: 'landng' is not one of cruise, takeoff, approach, landing; "
+     "did you mean 'landing'?"),
+    ("[aircraft]\nvs0_kcas = 0\n", "key aircraft.vs0_kcas: 0 is not a speed"),
+    ('[aircraft]\nvs1_kcas = "55"\n', "key aircraft.vs1_kcas: '55' is not a speed"),
+    ("[aircraft]\nvs1_kcs = 55\n", "key aircraft.vs1_kcs: unknown; did you mean "
+                                   "aircraft.vs1_kcas?"),
+])
+def test_rule_speeds_and_configuration_refused_naming_the_key(tmp_path, text, message):
+    from pitotcal.estimation.reporting.aircraft_file import aircraft_rule
+
+    path = tmp_path / "a.toml"
+    path.write_text(text)
+    with pytest.raises(PitotcalError, match=re.escape(message)):
+        aircraft_rule(path)
+
+
+def test_rule_speeds_read_and_free_text_configuration_kept(tmp_path):
+    from pitotcal.estimation.reporting.aircraft_file import aircraft_rule
+
+    path = tmp_path / "a.toml"
+    path.write_text('[aircraft]\nconfiguration = "Landing"\nvs0_kcas = 47\nvs1_kcas = 55.5\n')
+    assert aircraft_rule(path) == {"configuration": "landing",
+                                   "speeds_kcas": {"V_S0": 47.0, "V_S1": 55.5}}
+    assert ("V_S1 (KCAS)", "55.5") in read_aircraft(path)
+    path.write_text('[aircraft]\nconfiguration = "flaps 10, gear down"\nvs0_kcas = 47\n')
+    assert aircraft_rule(path)["configuration"] is None
+    assert ("Configuration", "flaps 10, gear down") in read_aircraft(path)
+
+
+def test_cli_configuration_choices_are_the_rules():
+    from pitotcal.cli.report import CONFIGURATIONS
+    from pitotcal.estimation.reporting import regulations
+
+    assert CONFIGURATIONS == regulations.CONFIGURATIONS

@@ -65,13 +65,46 @@ def test_refuses_a_track_that_did_not_turn_enough():
 
 
 def test_refuses_when_one_scale_cannot_represent_the_error():
-    # Δp/q_c from -0.05 at 70 kt to -0.02 at 100 kt: the inverse model departs from one scale
-    flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -40.0))[0]
+    # Δp/q_c from -0.40 at 70 kt to -0.15 at 100 kt: one ratio is off by 2.4 kt somewhere,
+    # more than the tolerance (a third of the 5 kt limit)
+    flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -250.0))[0]
     with pytest.raises(PitotcalError, match="a single ARSPD_RATIO cannot represent") as exc:
         recommend(flight, "ArduPilot", current=1.9936)
-    # the refusal states what one ratio would cost, in kt, and carries it
+    # the refusal states what one ratio would cost, in kt, and the tolerance it exceeds
     assert re.search(r"one value is off by up to \d+\.\d\d kt at \d+ KIAS", str(exc.value))
-    assert isinstance(exc.value, ParameterRefused) and exc.value.misfit["max_dv_kt"] > 0.3
+    assert "`misfit_tolerance_kt` 1.67 kt" in str(exc.value)
+    assert isinstance(exc.value, ParameterRefused) and exc.value.misfit["max_dv_kt"] > 2.0
+
+
+def test_a_significant_but_small_misfit_is_recommended_and_stated():
+    """Δp/q_c from -0.05 at 70 kt to -0.02 at 100 kt: the inverse model departs from one scale
+    far beyond its 2σ (statistically certain) but by 0.57 kt only: one ratio is recommended
+    with its misfit; a tolerance below it (`misfit_tolerance_kt`) refuses it."""
+    flight = synthetic_flight(seed=2, n=6000, model="inverse", k=(0.0, -40.0))[0]
+    rec = recommend(flight, "ArduPilot", current=1.9936)
+    m = rec.misfit
+    assert m["two_sigma_kt"] < m["max_dv_kt"] == pytest.approx(0.57, abs=0.05)
+    assert any("structure misfit 0.57 kt is within the tolerance 1.67 kt" in n
+               for n in rec.notes)
+    with pytest.raises(ParameterRefused, match="`misfit_tolerance_kt` 0.30 kt"):
+        recommend(flight, "ArduPilot", current=1.9936, misfit_tolerance_kt=0.3)
+    with pytest.raises(PitotcalError, match="misfit_tolerance_kt"):
+        recommend(flight, "ArduPilot", current=1.9936, misfit_tolerance_kt=0.0)
+
+
+def test_px4_sdp3x_compensation_is_warned_with_its_factor(constant_flight):
+    sdp3x = {"SENS_EN_SDP3X": 1, "CAL_AIR_CMODEL": 0, "CAL_AIR_TUBELEN": 0.2}
+    with pytest.warns(UserWarning, match="already includes its SDP3x compensation") as caught:
+        rec = recommend(constant_flight, "PX4", current=1.0, log_parameters=sdp3x)
+    factor = float(re.search(r"by a factor (\d\.\d+)", str(caught[0].message)).group(1))
+    # PX4's SDP3x flow model at the flight's median dp (about 1,000 Pa): the tip-speed term
+    # 0.125 x flow alone adds about 11 m/s to the 40 m/s of sqrt(2 dp/rho0)
+    assert factor == pytest.approx(1.27, abs=0.02)
+    assert any("SENS_EN_SDP3X set, CAL_AIR_CMODEL 0" in n for n in rec.notes)
+    # a membrane sensor (no SDP3x enabled): PX4 scales sqrt(2 dp/rho0) itself, no warning
+    plain = recommend(constant_flight, "PX4", current=1.0,
+                      log_parameters={"CAL_AIR_CMODEL": 0, "CAL_AIR_TUBED_MM": 1.5})
+    assert not any("SDP3x" in n for n in plain.notes)
 
 
 def _true_misfit(model, k, const, misfit):

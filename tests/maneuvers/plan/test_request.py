@@ -27,7 +27,7 @@ def test_defaults_are_the_t2_case():
     ({"cas_min_kt": 100, "cas_max_kt": 90}, "cas_min_kt",
      "cas_min_kt 100 must be below the top of the airspeed range, 90 KCAS"),
     ({"radius_m": 0}, "radius_m", "radius_m 0 must be > 0"),
-    ({"altitude_m": 20000}, "altitude_m", "altitude_m 20000 must be >= -400 and <= 11000"),
+    ({"altitude_m": 40000}, "altitude_m", "altitude_m 40000 must be >= -400 and <= 32000"),
     ({"duration_s": 20000}, "duration_s", "duration_s 20000 must be <= 14400 s"),
     ({"bank_max_deg": 90}, "bank_max_deg", "bank_max_deg 90 must be > 0 and <= 75"),
     ({"wind_from_deg": 400}, "wind_from_deg", "wind_from_deg 400 must be >= 0 and < 360"),
