@@ -610,6 +610,10 @@ def _option_cases():
               Case("identify window past the end", base["identify"] + ["--start-s", "1e5"]),
               Case("identify --live and a file", base["identify"] + ["--live",
                                                                      "udp:127.0.0.1:14550"]),
+              *[Case(f"identify --columns {n}", base["identify"] + ["--columns", f"{{root}}/{n}"],
+                     words=("--columns /",))
+                for n in ("binary.toml", "ac_syntax.toml", "ac_deep.toml", "folder",
+                          "nowhere.toml", "flight.csv", "ac_utf16.toml", "ac_typo.toml")],
               Case("simulate --fault garbage", base["simulate"] + ["--fault", "leak"]),
               Case("simulate --fault onset past", base["simulate"] + ["--fault",
                                                                       "blocked:1e9:30"]),
