@@ -140,7 +140,7 @@ def budget_example(tmp):
 
     _cli("plan", "--no-figures", "-o", tmp / "plan.csv")
     _cli("simulate", tmp / "plan.csv", "-o", tmp / "ex.csv", *BUDGET_SIM)
-    _cli("identify", tmp / "ex.csv", "--probe-arm-m", 1, "--json", tmp / "ex.json",
+    _cli("identify", tmp / "ex.csv", "--probe-arm-m", -1, "--json", tmp / "ex.json",
          "--plot", tmp / "ex.png")
     res = json.loads((tmp / "ex.json").read_text())
     truth = json.loads((tmp / "ex.truth.json").read_text())
@@ -167,7 +167,7 @@ def budget_example(tmp):
 # ---- studies (seeded, deterministic, but a minute or more each: only with --studies) -----------
 
 BUDGET_TERMS = ("statistical", "oat", "humidity", "gps_velocity_bias", "gps_latency",
-                "probe_lever_arm", "qc_scale", "qc_offset")
+                "probe_lever_arm", "qc_scale", "qc_offset", "static_pressure")
 
 
 def budget_study(tmp):
@@ -175,8 +175,8 @@ def budget_study(tmp):
     _cli("study", "budget", "--runs", 5, "--seed", 0, "--workers", 0, "--out", tmp)
     levels = json.loads((tmp / "budget.json").read_text())["by_turbulence_mps"]
     out = ["", "", "| turbulence | 2σ | U (k = 2) | u stat | u OAT | u humidity | u GPS bias | "
-                   "u latency | u probe arm | u gain | u offset |",
-           "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+                   "u latency | u probe arm | u gain | u offset | u static |",
+           "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for level, row in sorted(levels.items(), key=lambda kv: float(kv[0])):
         calm = float(level) == 0
         two = f"{row['two_sigma_kt']:.3f}" if calm else f"{row['two_sigma_kt']:.2f}"

@@ -29,6 +29,7 @@ from .real_alfa.study import STUDY as REAL_ALFA
 from .engine.runner import RunsInterrupted, count_errors, output_folder, write_table
 from .accuracy.sample_size import STUDY as SAMPLE_SIZE
 from .accuracy.sensitivity import STUDY as SENSITIVITY
+from .accuracy.tails import STUDY as COVERAGE_TAILS
 from .engine.study import StudySettings
 from .accuracy.wind import STUDY as WIND
 
@@ -40,7 +41,7 @@ log = logging.getLogger(__name__)
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
                                PEERS, LEGS, DESIGN, MONITOR, BUDGET,
                                LEGS_FLIGHT, NOISE,
-                               LEAK)}
+                               LEAK, COVERAGE_TAILS)}
 
 
 class StudyInterrupted(KeyboardInterrupt):

@@ -67,17 +67,23 @@ def _constants():
     from pitotcal.maneuvers.plan.request import PlanRequest
     from pitotcal.studies.demo import DEMO_SIM
 
+    from pitotcal.estimation.identification import sensor_inputs
+
     b, d, m = budget.BudgetInputs(), DesignOptions(), MonitorOptions()
+    c = sensor_inputs.CLASS_DEFAULTS[sensor_inputs.DEFAULT_SENSOR_CLASS]
     return [
         ("identify", f"else {budget.RH_U_UNKNOWN_PCT:.0f} (dry assumed"),
         ("identify", f"default {budget.RH_U_GIVEN_PCT:g} with a humidity"),
         ("identify", f"up to {2 * len(budget.SOURCES)} extra solves"),
-        ("identify", f"static air temperature, K; default {b.u_oat_k:g}"),
-        ("identify", f"bias per axis, m/s; default {b.u_gps_velocity_mps:g}"),
-        ("identify", f"time alignment, s; default {b.u_gps_latency_s:g}"),
+        ("identify", f"static air temperature, K; default by its source: a probe "
+                     f"{c['u_oat_probe_k']:g} (flight-test)"),
+        ("identify", f"bias per axis, m/s; default {c['u_gps_velocity_mps']:g}"),
+        ("identify", f"time alignment, s; default {c['u_gps_latency_s']:g}"),
         ("identify", f"V_t - r y; default {b.probe_arm_m:g}"),
-        ("identify", f"% of reading; default {100 * b.u_qc_scale:g}"),
-        ("identify", f"zero offset, Pa; default {b.u_qc_offset_pa:g}"),
+        ("identify", f"% of reading; default {100 * c['u_qc_scale']:g}"),
+        ("identify", f"zero offset, Pa; default {c['u_qc_offset_pa']:g}"),
+        ("identify", f"static-pressure transducer, Pa; default {c['u_ps_pa']:g}"),
+        ("identify", f"default {100 * sensor_inputs.ARM_U_FRACTION:g} % of --probe-arm-m"),
         *[("legs", f"(default: {value:g})") for value in DETECT_DEFAULTS.values()],
         ("legs", f"form one point (default {POINT_TOL_KT:g})"),
         ("legs", f"one wind per {BAND_FT:,.0f} ft"),

@@ -14,26 +14,28 @@ For an effect linear in x_j this is |∂ΔV/∂x_j| u, the GUM's first-order ter
 is not linear (the GPS latency is partly quadratic: a misalignment either way degrades the
 fit alike) it keeps the second-order part a central difference would cancel. The tests check
 each term against re-solves at half the step and against the bias the simulator injects.
-The inputs, what is perturbed, and the defaults (GUM: a rectangular limit a counts a/√3):
+The inputs and what is perturbed; the defaults come from the sensor class and, for the OAT, the
+temperature's source (`sensor_inputs`, which also lists where each value came from):
 
-- oat: static air temperature, u = 1 K (a calibrated OAT probe ±1 K); the
-  density ρ → ρ T/(T ± u) and the static temperature itself.
+- oat: static air temperature; the density ρ → ρ T/(T ± u) and the static temperature itself.
 - humidity: relative humidity, u = 5 %RH with a humidity channel or --rh-percent, else 58 %RH
   (= 100/√3: dry air assumed while the truth is anywhere in 0-100 %, so the error is one-sided
   and its RMS is the effect at 100/√3, not the 50/√3 of an estimate centred at 50 %); ρ
   through the virtual temperature.
-- gps_velocity_bias: a constant GPS velocity error per axis, u = 0.05 m/s (u-blox M8/M9 speed
-  accuracy). A horizontal bias b is the wind's: V_g + b − W = V_g − (W − b), so the fitted wind
+- gps_velocity_bias: a constant GPS velocity error per axis (u-blox M8/M9 speed accuracy,
+  0.05 m/s). A horizontal bias b is the wind's: V_g + b − W = V_g − (W − b), so the fitted wind
   absorbs it exactly and ΔV does not move (the tests re-solve to show it); only the vertical
   channel is re-solved.
-- gps_latency: the GPS velocity's age relative to the pressure, u = 0.05 s (a receiver's
-  latency known to within a navigation cycle); the GPS channels shifted in time.
+- gps_latency: the GPS velocity's age relative to the pressure (a receiver's latency known to
+  within a navigation cycle); the GPS channels shifted in time.
 - probe_lever_arm: a probe at y = arm on the wing sees V_t − r·y in a turn at yaw rate r
-  (ω × r); u = |arm| (`--probe-arm-m`, default 0: the fit assumes the probe on the centre line);
-  q_ci → q_ci (1 ∓ r·arm / V_t)², r = ψ̇ cos φ from the air-relative heading rate, tan φ = V ψ̇/g.
-- qc_scale, qc_offset: the transducer's calibration, u = 0.1 % of reading and 1 Pa (a
-  calibrated flight-test transducer; a hobby MEMS sensor is 1 % and 5-10 Pa): ΔV_pc is the
-  position error only if the transducer's own error is known to this.
+  (ω × r), r = ψ̇ cos φ from the air-relative heading rate, tan φ = V ψ̇/g. A known arm is
+  corrected in the data (`lever_arm_corrected`, `identify(..., probe_arm_m=)`); this term is
+  the arm's own uncertainty: q_ci → q_ci (1 ∓ r·u / V_t)².
+- qc_scale, qc_offset: the differential transducer's gain and zero: ΔV_pc is the position
+  error only if the transducer's own error is known to this.
+- static_pressure: the static transducer: p_s ± u and the density made of it (ρ ∝ p_s); it
+  moves the compressibility and the density the TAS comes from.
 
 A compressible result's static-source products, the altimeter correction ΔH_pc (ft) and the
 Mach correction ΔM_pc, get the same budget from the same re-solves: each perturbed calibration
@@ -42,12 +44,10 @@ differenced as ΔV is, and the statistical part is their own 2σ / 2 (`Budget.pr
 """
 
 import dataclasses
-import math
 import warnings
 
 import numpy as np
 
-from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import delta_v_kt_where_defined, get_model
 from pitotcal.core.moist_air import moist_density_kgm3
@@ -59,7 +59,10 @@ from pitotcal.core.units import (
     wind_vector_mps,
 )
 
-__all__ = ["COVERAGE_K", "SOURCES", "Budget", "BudgetInputs", "uncertainty_budget"]
+from .sensor_inputs import RH_U_GIVEN_PCT, RH_U_UNKNOWN_PCT, BudgetInputs, resolve
+
+__all__ = ["COVERAGE_K", "RH_U_GIVEN_PCT", "RH_U_UNKNOWN_PCT", "SOURCES", "Budget", "BudgetInputs",
+           "uncertainty_budget"]
 
 COVERAGE_K = 2.0
 # (source name in the JSON, BudgetInputs field of its standard uncertainty, unit)
@@ -68,43 +71,11 @@ SOURCES = (
     ("humidity", "u_rh_pct", "%RH"),
     ("gps_velocity_bias", "u_gps_velocity_mps", "m/s"),
     ("gps_latency", "u_gps_latency_s", "s"),
-    ("probe_lever_arm", "probe_arm_m", "m"),
+    ("probe_lever_arm", "u_probe_arm_m", "m"),
     ("qc_scale", "u_qc_scale", "1"),
     ("qc_offset", "u_qc_offset_pa", "Pa"),
+    ("static_pressure", "u_ps_pa", "Pa"),
 )
-RH_U_GIVEN_PCT = 5.0                       # a humidity channel's standard uncertainty
-RH_U_UNKNOWN_PCT = 100.0 / math.sqrt(3.0)  # dry assumed, truth anywhere in 0-100 %RH: RMS error
-
-
-@dataclasses.dataclass(frozen=True)
-class BudgetInputs:
-    """Standard uncertainties of the Type B inputs (module notes give each default's source).
-
-    `u_rh_pct` None: 5 %RH when the flight has a humidity, else 58 %RH (dry assumed).
-    """
-
-    u_oat_k: float = 1.0
-    u_rh_pct: float | None = None
-    u_gps_velocity_mps: float = 0.05
-    u_gps_latency_s: float = 0.05
-    probe_arm_m: float = 0.0
-    u_qc_scale: float = 0.001
-    u_qc_offset_pa: float = 1.0
-
-    def checked(self):
-        """A copy with every value checked (PitotcalError naming the field) and rh resolved."""
-        out = {}
-        for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            if value is None:
-                out[f.name] = None
-            elif f.name == "probe_arm_m":
-                out[f.name] = checks.number(f.name, value, -50.0, 50.0)
-            else:
-                out[f.name] = checks.number(f.name, value, 0.0)
-        return BudgetInputs(**out)
-
-
 @dataclasses.dataclass(frozen=True)
 class Budget:
     """The budget over the correction table's speeds.
@@ -123,6 +94,9 @@ class Budget:
     products : dict
         Static-source product ("dh_ft", "dmach") -> {"statistical": σ at each speed, source
         name -> u_j at each speed}, in the product's unit; empty for an incompressible result.
+    input_list : tuple of dict
+        Every input with its value and where it came from ({input, value, unit, origin}:
+        `sensor_inputs.resolve`): the JSON's ``budget_inputs``.
     """
 
     vi_kt: np.ndarray
@@ -131,6 +105,7 @@ class Budget:
     inputs: dict
     warnings: tuple = ()
     products: dict = dataclasses.field(default_factory=dict)
+    input_list: tuple = ()
 
     @property
     def combined_kt(self):
@@ -161,10 +136,14 @@ class Budget:
     def to_list(self):
         """The JSON's `uncertainty_budget`: statistical first, each u_dv_kt its max over V_i."""
         rows = [{"source": "statistical", "u_dv_kt": float(np.max(self.statistical_kt))}]
+        origin = {r["input"]: r["origin"] for r in self.input_list}
+        fields = {name: field for name, field, _ in SOURCES}
         for name, u in self.terms_kt.items():
             u_in, unit = self.inputs[name]
-            rows.append({"source": name, "u_dv_kt": float(np.max(u)), "u_input": u_in,
-                         "unit": unit})
+            row = {"source": name, "u_dv_kt": float(np.max(u)), "u_input": u_in, "unit": unit}
+            if fields.get(name) in origin:
+                row["origin"] = origin[fields[name]]
+            rows.append(row)
         return rows
 
 
@@ -174,7 +153,8 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     Parameters
     ----------
     flight : pitotcal.core.flight.Flight
-        The flight `result` was identified from (as passed to `identify`).
+        The flight `result` was identified from (as passed to `identify`; corrected here for
+        the probe lever arm `identify` corrected it for, `result.reading["probe_arm_m"]`).
     result : IdentificationResult
     inputs : BudgetInputs, optional
         Standard uncertainties of the Type B inputs; default `BudgetInputs()`.
@@ -190,7 +170,7 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     Notes
     -----
     Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
-    vertical channel): at most 14, each reusing `identify`'s cached solver
+    vertical channel): at most 16, each reusing `identify`'s cached solver
     (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
     identify's estimate without the bounds and consistency checks the budget does not use.
     A compressible result's ΔH_pc and ΔM_pc get their budget from the same re-solves
@@ -205,18 +185,17 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
     """The airspeed budget of `uncertainty_budget`; each source's re-solves go to `solved`."""
     from .fit import estimate
 
-    inputs = (inputs or BudgetInputs()).checked()
+    flight = _fitted_samples(flight, result)
+    arm_m = (result.reading or {}).get("probe_arm_m")
+    if arm_m and not (getattr(flight, "reading", None) or {}).get("probe_arm_m"):
+        flight = lever_arm_corrected(flight, result, arm_m)     # re-solve what was fitted
+    inputs, input_list = resolve(inputs, flight)
     rows = result.correction_table()
     vi = np.array([r["vi_kt"] for r in rows])
     stat = np.array([r["dv_2sigma_kt"] for r in rows]) / 2.0
     kwargs = {**identify_kwargs, "gps_noise_std_mps": result.gps_noise_std_mps,
               "model": result.model}
-    u_rh = inputs.u_rh_pct
-    if u_rh is None:
-        u_rh = RH_U_GIVEN_PCT if flight.rh_pct is not None else RH_U_UNKNOWN_PCT
-    inputs = dataclasses.replace(inputs, u_rh_pct=u_rh)
     notes = []
-
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
 
     def sensitivity(perturb, name):
@@ -262,7 +241,7 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
     return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,
                   inputs={name: (abs(getattr(inputs, field)), unit)
                           for name, field, unit in SOURCES},
-                  warnings=tuple(dict.fromkeys(notes)))
+                  warnings=tuple(dict.fromkeys(notes)), input_list=tuple(input_list))
 
 
 # static-source product -> the JSON row's keys of its U and of its terms
@@ -311,6 +290,15 @@ def _rms_change(perturbed, key, base):
         return np.full_like(base, np.nan)
     d = [p[key] - base for p in perturbed]
     return np.sqrt((d[0] ** 2 + d[1] ** 2) / 2.0)
+
+
+def _fitted_samples(flight, result):
+    """The samples `result` was fitted on: without a collapsed tail it removed
+    (`consistency.collapse_onset_s`), so its re-solves are fitted on the same."""
+    collapse = (result.consistency or {}).get("collapse")
+    if not collapse:
+        return flight
+    return flight.select(flight.time_s < collapse["removed_from_s"])
 
 
 # --- perturbed flights (Flight, result, signed step) -> Flight --------------------------------
@@ -392,6 +380,25 @@ def lever_arm_error(flight, result, arm_m):
     return dataclasses.replace(flight, qci_pa=flight.qci_pa * (1.0 - r * arm_m / tas) ** 2)
 
 
+def lever_arm_corrected(flight, result, arm_m):
+    """`flight` corrected for a probe at y = arm_m: q_ci / (1 − r y / V_t)², the arm recorded
+    in its `reading` (``probe_arm_m``); r and V_t from `result`'s wind (`yaw_rate_rps`)."""
+    r, tas = yaw_rate_rps(flight, result)
+    reading = {**(getattr(flight, "reading", None) or {}), "probe_arm_m": float(arm_m)}
+    return dataclasses.replace(flight, qci_pa=flight.qci_pa / (1.0 - r * arm_m / tas) ** 2,
+                               reading=reading)
+
+
+def static_pressure_error(flight, result, dp_pa):
+    """The static transducer dp_pa high: p_s + dp and the density made of it, ρ ∝ p_s."""
+    t = static_temperature_of(flight)
+    ps = flight.ps_pa if flight.ps_pa is not None else flight.rho_kgm3 * R_AIR_JKGK * t
+    out = {"rho_kgm3": flight.rho_kgm3 * (ps + dp_pa) / ps}
+    if flight.ps_pa is not None:
+        out["ps_pa"] = flight.ps_pa + dp_pa
+    return dataclasses.replace(flight, **out)
+
+
 def qc_scale_error(flight, result, scale):
     return dataclasses.replace(flight, qci_pa=flight.qci_pa * (1.0 + scale))
 
@@ -402,7 +409,8 @@ def qc_offset_error(flight, result, offset_pa):
 
 PERTURBATIONS = {"oat": oat_error, "humidity": humidity_error,
                  "gps_latency": gps_latency_error, "probe_lever_arm": lever_arm_error,
-                 "qc_scale": qc_scale_error, "qc_offset": qc_offset_error}
+                 "qc_scale": qc_scale_error, "qc_offset": qc_offset_error,
+                 "static_pressure": static_pressure_error}
 
 
 def inputs_from_options(**options):
@@ -413,3 +421,4 @@ def inputs_from_options(**options):
         raise PitotcalError(f"unknown budget input {unknown[0]!r}; known: "
                             f"{', '.join(sorted(names))}", param=unknown[0])
     return BudgetInputs(**{k: v for k, v in options.items() if v is not None}).checked()
+

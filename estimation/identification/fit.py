@@ -140,6 +140,16 @@ def _fit_trimmed(flight, fit, air_data, check=True):
         result = _with_static_fit(result)
     step_note, found = _consistency(kept, result, air_data) if result.success and check \
         else ((), {})
+    cut = consistency.collapse_onset_s(found, kept.time_s) if found else None
+    if cut is not None:
+        try:
+            result, step_note, found = _without_collapse(kept, fit, air_data, cut, found)
+        except PitotcalError as exc:    # what is left cannot be fitted: the whole, named
+            step_note = (f"{flight.source}: q_ci collapses at the end of the record (from "
+                         f"about t = {cut:.0f} s){_scan_text(found)}: a "
+                         "blocked pitot or icing? The calibration below is fitted on the "
+                         "whole record because the samples before it cannot be fitted alone "
+                         f"({exc}); do not use it",) + tuple(step_note)
     result = dataclasses.replace(result, consistency=found)
     if keep.all():
         return result, step_note
@@ -148,6 +158,33 @@ def _fit_trimmed(flight, fit, air_data, check=True):
         f"{gates.trim_threshold(flight.n):.1f} sigma of the fitted noise, a false-trim rate of "
         f"{gates.FALSE_TRIM_RATE:g} per flight under Gaussian noise) and the fit repeated "
         f"without them: {gates.spans_text(flight.time_s, ~keep)}"),) + step_note
+
+
+def _without_collapse(flight, fit, air_data, cut_s, found):
+    """(result, warnings, consistency): the fit refitted on the samples before `cut_s`, the
+    collapsed tail of q_ci (`consistency.collapse_onset_s`) removed and named; the
+    consistency checks repeated on what is kept."""
+    head = flight.select(flight.time_s < cut_s)
+    result = _with_static_fit(fit(head))
+    note = (f"{flight.source}: q_ci collapses at the end of the record: by the end "
+            f"({flight.time_s[-1]:.0f} s) it reads {100 * found['end_ratio']:.0f}% of the "
+            f"impact pressure the GPS and the wind give (median over the record: 100%)"
+            f"{_scan_text(found)}: a blocked pitot or icing? The samples from "
+            f"t = {cut_s:.0f} s on ({int(flight.n - head.n)}) are removed and the calibration "
+            f"is fitted on t = {head.time_s[0]:.0f}-{head.time_s[-1]:.0f} s")
+    step_note, again = _consistency(head, result, air_data) if result.success else ((), {})
+    return result, (note,) + tuple(step_note), {**again, "collapse": {
+        "onset_s": found["onset_s"], "kind": found["kind"], "step": found["step"],
+        "z": found["z"], "flagged": found["flagged"], "end_ratio": found["end_ratio"],
+        "removed_from_s": float(cut_s), "n_removed": int(flight.n - head.n)}}
+
+
+def _scan_text(found):
+    """The step test's part of the collapse warning: its onset and z when it flagged."""
+    if not found["flagged"]:
+        return ""
+    return (f"; the consistency scan puts a {found['kind']} from about "
+            f"t = {found['onset_s']:.0f} s, z = {found['z']:+.1f}")
 
 
 def _consistency(flight, result, air_data):

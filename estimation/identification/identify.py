@@ -9,6 +9,7 @@ import functools
 
 import numpy as np
 
+from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA, INCOMPRESSIBLE_MACH_MAX, flight_mach
 from pitotcal.core.moist_air import at_mach
@@ -17,7 +18,7 @@ from pitotcal.io.result_record import check_noise_model
 
 from ..uncertainty.block_noise import block_residual_stats
 from . import static_source
-from .budget import BudgetInputs, uncertainty_budget
+from .budget import BudgetInputs, lever_arm_corrected, uncertainty_budget
 from .fit import (
     MAX_CORRELATION,
     MIN_QCI_SPAN,
@@ -34,7 +35,8 @@ __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_D
 
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
-             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None):
+             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None,
+             probe_arm_m=0.0):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -64,7 +66,10 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     budget : BudgetInputs or True, optional
         Compute the GUM uncertainty budget of the airspeed correction
         (`estimation.identification.budget`) with these Type B inputs (True: the defaults);
-        it costs up to 14 re-solves. None (the default): no budget.
+        it costs up to 16 re-solves. None (the default): no budget.
+    probe_arm_m : float
+        Lateral position of the pitot probe, m (right wing +), corrected in the data
+        (`_fit_corrected`); the record's `reading` keeps it. Default 0.
 
     Returns
     -------
@@ -104,10 +109,12 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     -15.0...
     """
     inputs = budget_inputs(budget)
-    refit = functools.partial(fit, model=model, air=air, gps_noise_std_mps=gps_noise_std_mps,
-                              ipopt_options=ipopt_options, gps_error_sigma_mps=gps_error_sigma_mps,
-                              gps_error_tau_s=gps_error_tau_s)
-    result, flight = _at_calibrated_mach(refit(flight), flight, refit)
+    arm_m = checks.number("probe_arm_m", probe_arm_m, -50.0, 50.0)
+    options = {"air": air, "gps_noise_std_mps": gps_noise_std_mps, "ipopt_options": ipopt_options,
+               "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s}
+    flight, result = _fit_corrected(flight, model, arm_m, options)
+    refit = functools.partial(fit, model=model, **options)
+    result, flight = _at_calibrated_mach(result, flight, refit)
     return complete(result, flight, air=air, budget=inputs,
                     gps_error=(gps_error_sigma_mps, gps_error_tau_s))
 
@@ -135,6 +142,20 @@ def _at_calibrated_mach(result, flight, refit):
         if step < TEMPERATURE_TOL_K:
             break
     return result, flight
+
+
+def _fit_corrected(flight, model, arm_m, options):
+    """(flight, fit): with a probe lever arm, the flight corrected for it and fitted again.
+
+    In a turn at yaw rate r the probe at y = arm_m sees V_t − r y, so q_ci is divided by
+    (1 − r y / V_t)² (`budget.lever_arm_corrected`); r and V_t need the wind, which a first
+    fit gives.
+    """
+    result = fit(flight, model, **options)
+    if not arm_m:
+        return flight, result
+    flight = lever_arm_corrected(flight, result, arm_m)
+    return flight, fit(flight, model, **options)
 
 
 def budget_inputs(budget):

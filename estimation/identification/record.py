@@ -88,8 +88,9 @@ def _static_source_record(result):
 def with_budget(out, budget):
     """`out` (a record) with `dv_U_kt` and `u_dv_by_source_kt` (each source's standard
     uncertainty of ΔV at that speed, kt) per correction row, a compressible result's ΔH and ΔM
-    the same (`Budget.product_row`), `uncertainty_budget`, and the budget's warnings; the rows
-    are matched by speed (the budget has the table's speeds)."""
+    the same (`Budget.product_row`), `uncertainty_budget`, `budget_inputs` (every input, its
+    value and where it came from) and the budget's warnings; the rows are matched by speed (the
+    budget has the table's speeds)."""
     at = {round(float(v), 6): i for i, v in enumerate(budget.vi_kt)}
     new_rows = []
     for row in out.get("airspeed_correction", []):
@@ -102,4 +103,6 @@ def with_budget(out, budget):
     warnings = list(out.get("warnings", []))
     warnings += [w for w in budget.warnings if w not in warnings]
     return json_ready({**out, "airspeed_correction": new_rows,
-                       "uncertainty_budget": budget.to_list(), "warnings": warnings})
+                       "uncertainty_budget": budget.to_list(),
+                       "budget_inputs": list(getattr(budget, "input_list", ())),
+                       "warnings": warnings})

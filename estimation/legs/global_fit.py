@@ -202,7 +202,8 @@ def fit_legs(legs, model="inverse", wind="per-band", initial_winds=None):
     def residuals(z):
         k = z[:nk] * scales
         w = z[nk:].reshape(ng, 2)[group]
-        v = predicted_tas_mps(pe, k, legs.qci_pa, ps_ind, legs.oat_k)
+        oat = legs.static_oat_k(qc_from_qci_pa(pe, k, legs.qci_pa))  # a tat_k's true Mach
+        v = predicted_tas_mps(pe, k, legs.qci_pa, ps_ind, oat)
         return (np.hypot(*(g - w).T) - v) / sigma
 
     z0 = np.zeros(nk + 2 * ng)

@@ -28,8 +28,18 @@ velocity error (a dilution of precision: 0.58 for tracks 120° apart, 0.71 for N
 TAS → CAS is compressible (`pitotcal.core.airdata`) at the leg's pressure altitude and OAT, with
 the position error taken as static-source error, p_s = p_s,ind − (q_c − q_ci) (iterated).
 ΔV_pc = V_c − V_ic.
+
+Legs flown at different indicated airspeeds (or altitudes, or OATs) fly different TAS: each leg's
+circle has its own radius V + δ_i, V the TAS at the point's mean q_ci, altitude and OAT, and δ_i
+the leg's TAS less that one at the same pressure-error ratio Δp/q_ci (the position error of
+legs a knot or two apart is the same fraction of q_c). Each 3-leg subset is then solved by
+Newton's method on |g_i − w|² = (V + δ_i)² from the one-radius circle, and δ_i re-computed with
+the ratio the solution gives until the ratio moves less than 1e-9 (six rounds at most). With
+δ_i = 0 this is the one-radius circle exactly. A total-temperature column (`LegData.tat_k`)
+is converted with each leg's true Mach at that ratio, in the same rounds.
 """
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass
@@ -53,6 +63,8 @@ DOP_MAX = 10.0
 MAX_SUBSETS = 5000
 _MAX_NOTES = 10            # subsets named one by one in the warnings; the rest counted
 _COLLINEAR = 1e-9          # relative smallest singular value of the circle's linear system
+_NEWTON_STEPS = 20         # per-leg radii: Newton from the one-radius circle (3-5 suffice)
+_TAS_ROUNDS = 6            # per-leg TAS re-computed with the solution's pressure-error ratio
 
 
 @dataclass(frozen=True)
@@ -69,6 +81,7 @@ class PointSolution:
     ias_kt, pressure_alt_m, oat_k, qci_pa : float
         Mean indicated airspeed, indicated pressure altitude, OAT and q_ci over the legs.
     tas_mps, wind_n_mps, wind_e_mps : float
+        TAS at the mean q_ci, altitude and OAT (each leg flies its own, module notes), wind.
     cov : ndarray, shape (3, 3)
         Covariance of (w_N, w_E, V) (NaN when `bound` is "none").
     half_width_factor : float
@@ -85,7 +98,9 @@ class PointSolution:
         The mean of the legs' ground speeds, what a naive average would call TAS (biased by
         about |w|²/(2V) sin² of the wind angle, e.g. +1 kt for 20 kt of wind at 100 kt).
     residuals_mps : ndarray
-        r_i = |g_i − w| − V.
+        r_i = |g_i − w| − (V + δ_i).
+    tas_offsets_mps : ndarray
+        δ_i, each leg's TAS less V (zero when the legs share q_ci, altitude and OAT).
     """
 
     point: str
@@ -110,6 +125,7 @@ class PointSolution:
     tas_half_mps: float
     naive_tas_mps: float
     residuals_mps: np.ndarray
+    tas_offsets_mps: np.ndarray = None
 
     @property
     def wind(self):
@@ -118,13 +134,15 @@ class PointSolution:
         return float(speed), float(frm)
 
 
-def three_leg(g_ne):
+def three_leg(g_ne, delta=None):
     """TAS and wind from three ground velocities: the circle through three points.
 
     Parameters
     ----------
     g_ne : array_like, shape (3, 2)
         Ground velocities (north, east), any speed unit.
+    delta : array_like, shape (3,), optional
+        Each leg's TAS less V, in the unit of `g_ne` (module notes); None: one TAS.
 
     Returns
     -------
@@ -149,14 +167,27 @@ def three_leg(g_ne):
     g = np.asarray(g_ne, dtype=float)
     a = np.column_stack([2.0 * g, np.ones(3)])
     wn, we, c = np.linalg.solve(a, np.sum(g ** 2, axis=1))
-    return np.array([wn, we, np.sqrt(c + wn ** 2 + we ** 2)])
+    x = np.array([wn, we, np.sqrt(c + wn ** 2 + we ** 2)])
+    if delta is None or not np.any(delta):
+        return x
+    delta = np.asarray(delta, dtype=float)
+    for _ in range(_NEWTON_STEPS):
+        d = g - x[:2]
+        f = np.sum(d ** 2, axis=1) - (x[2] + delta) ** 2
+        step = np.linalg.solve(np.column_stack([-2.0 * d, -2.0 * (x[2] + delta)]), -f)
+        x = x + step
+        if np.max(np.abs(step)) <= 1e-12 * max(1.0, abs(x[2])):
+            break
+    return x
 
 
-def circle_jacobian(g_ne, x):
-    """d(w_N, w_E, V)/d(g_1N, g_1E, g_2N, ...), shape (3, 6), of the 3-leg solution `x`."""
+def circle_jacobian(g_ne, x, delta=None):
+    """d(w_N, w_E, V)/d(g_1N, g_1E, g_2N, ...), shape (3, 6), of the 3-leg solution `x`
+    (`delta`: each leg's TAS less V, as `three_leg`)."""
     g = np.asarray(g_ne, dtype=float)
     d = g - x[:2]
-    dfdx = np.column_stack([-2.0 * d, -2.0 * x[2] * np.ones(3)])
+    radius = x[2] if delta is None else x[2] + np.asarray(delta, dtype=float)
+    dfdx = np.column_stack([-2.0 * d, -2.0 * radius * np.ones(3)])
     dfdg = np.zeros((3, 6))
     for i in range(3):
         dfdg[i, 2 * i:2 * i + 2] = 2.0 * d[i]
@@ -198,18 +229,20 @@ def _describe(legs, idx):
     return f"point {legs.point[idx[0]]} (tracks {tracks})"
 
 
-def _subset_solutions(legs, idx, g):
+def _subset_solutions(legs, idx, g, delta):
     """Solutions and leg-space Jacobians (3, 2N) of the well-conditioned subsets; the DOP."""
     sols, dops, refused = [], [], []
     jac = np.zeros((3, 2 * len(idx)))          # summed: one (3, 2N) matrix whatever N
+    delta = delta if np.any(delta) else None   # one radius: the closed form, no copies
     for sub in subsets(len(idx)):
         gs = g[list(sub)]
         _, dop = _conditioning(gs)
         if not dop <= DOP_MAX:
             refused.append((sub, dop))
             continue
-        x = three_leg(gs)
-        dx = circle_jacobian(gs, x)
+        ds = None if delta is None else delta[list(sub)]
+        x = three_leg(gs, ds)
+        dx = circle_jacobian(gs, x, ds)
         for k, leg in enumerate(sub):
             jac[:, 2 * leg:2 * leg + 2] += dx[:, 2 * k:2 * k + 2]
         sols.append(x)
@@ -263,8 +296,7 @@ def solve_point(legs, label):
             f"{legs.source}: point {label} has {n} leg{'s' * (n != 1)}: three legs on "
             f"different tracks are needed to solve for TAS and wind")
     g = legs.velocity_ne_mps()[idx]
-    sols, jac, refused, dop = _subset_solutions(legs, idx, g)
-    x = sols.mean(axis=0)
+    x, sols, jac, refused, dop, delta, ratio = _per_leg_solution(legs, idx, g)
     notes = [f"{_describe(legs, idx[list(s)])}: subset left out, ground velocities nearly "
              f"collinear (TAS DOP {d:.0f} > {DOP_MAX:g})" for s, d in refused[:_MAX_NOTES]]
     if len(refused) > _MAX_NOTES:
@@ -274,7 +306,7 @@ def solve_point(legs, label):
         notes.append(f"point {label}: {n} legs, {math.comb(n, 3)} 3-leg subsets: the mean of "
                      f"{MAX_SUBSETS} of them drawn at random (seeded, so reproducible; its "
                      "sampling error is a small part of the bound)")
-    resid = np.hypot(*(g - x[:2]).T) - x[2]
+    resid = np.hypot(*(g - x[:2]).T) - (x[2] + delta)
     sd = legs.groundspeed_sd_mps[idx]
     if np.all(np.isfinite(sd) & (sd > 0)):
         bound, factor, sigma = legs.sd_from, 2.0, np.repeat(sd, 2)
@@ -286,18 +318,61 @@ def solve_point(legs, label):
         notes.append(f"point {label}: three legs and no groundspeed_sd_kt: no bound (fly a "
                      f"fourth leg, or state the GPS accuracy)")
     cov = (jac * sigma ** 2) @ jac.T
-    if np.ptp(legs.ias_kt[idx]) > 2.0:
-        notes.append(f"point {label}: the legs' ias_kt differ by {np.ptp(legs.ias_kt[idx]):.1f} "
-                     f"kt; the method assumes one airspeed per point")
-    return _finish(legs, label, idx, x, sols, cov, factor, bound, dop, g, resid), notes
+    return dataclasses.replace(_finish(legs, label, idx, x, sols, cov, factor, bound, dop, g,
+                                       resid, ratio), tas_offsets_mps=delta), notes
 
 
-def _finish(legs, label, idx, x, sols, cov, factor, bound, dop, g, resid):
+def _reference(legs, idx, ratio=0.0):
+    """The point's (mean q_ci, indicated static pressure at the mean altitude, mean OAT); the
+    OAT of a total-temperature column at the pressure-error ratio's true Mach."""
+    qc = legs.qci_pa[idx] * (1.0 + ratio)
+    return (float(np.mean(legs.qci_pa[idx])),
+            float(airdata.static_pressure_pa(float(np.mean(legs.pressure_alt_m[idx])))),
+            float(np.mean(legs.static_oat_k(qc, idx))))
+
+
+def _tas_at_ratio(qci_pa, ps_ind_pa, oat_k, ratio):
+    """TAS, m/s, of a leg whose impact pressure is q_ci (1 + ratio), the error in the static
+    source: p_s = p_s,ind − q_ci ratio (module notes)."""
+    qc = np.asarray(qci_pa, dtype=float) * (1.0 + ratio)
+    ps = np.asarray(ps_ind_pa, dtype=float) - np.asarray(qci_pa, dtype=float) * ratio
+    return airdata.mach_from_qc(qc, ps) * airdata.speed_of_sound_mps(oat_k)
+
+
+def _tas_offsets(legs, idx, ratio):
+    """δ_i: each leg's TAS less the point's reference TAS at the same pressure-error ratio."""
+    ps_ind = airdata.static_pressure_pa(legs.pressure_alt_m[idx])
+    ref = _tas_at_ratio(*_reference(legs, idx, ratio), ratio)
+    oat = legs.static_oat_k(legs.qci_pa[idx] * (1.0 + ratio), idx)
+    return _tas_at_ratio(legs.qci_pa[idx], ps_ind, oat, ratio) - ref
+
+
+def _per_leg_solution(legs, idx, g):
+    """(x, subset solutions, Jacobian, refused subsets, DOP, δ, pressure-error ratio) with each
+    leg's own TAS: δ at the indicated values first, then at the ratio of the solution's TAS
+    (which also sets a total-temperature column's true Mach)."""
+    ratio = 0.0
+    delta = _tas_offsets(legs, idx, ratio)
+    sols, jac, refused, dop = _subset_solutions(legs, idx, g, delta)
+    x = sols.mean(axis=0)
+    if not np.any(delta) and legs.tat_k is None:
+        return x, sols, jac, refused, dop, delta, ratio
+    for _ in range(_TAS_ROUNDS):
+        qci, ps_ind, oat = _reference(legs, idx, ratio)
+        new = float(cas_from_tas_mps(x[2], qci, ps_ind, oat)[1]) / qci - 1.0
+        delta, moved, ratio = _tas_offsets(legs, idx, new), abs(new - ratio), new
+        if np.any(delta):
+            sols, jac, refused, dop = _subset_solutions(legs, idx, g, delta)
+            x = sols.mean(axis=0)
+        if moved < 1e-9:
+            break
+    return x, sols, jac, refused, dop, delta, ratio
+
+
+def _finish(legs, label, idx, x, sols, cov, factor, bound, dop, g, resid, ratio=0.0):
     """TAS → CAS and ΔV with their half-widths (dV_c/dV_t by central difference)."""
-    qci = float(np.mean(legs.qci_pa[idx]))
+    qci, ps_ind, oat = _reference(legs, idx, ratio)
     alt = float(np.mean(legs.pressure_alt_m[idx]))
-    oat = float(np.mean(legs.oat_k[idx]))
-    ps_ind = float(airdata.static_pressure_pa(alt))
     ias_mps = float(airdata.cas_from_qc_mps(qci))
     vc, qc = cas_from_tas_mps(x[2], qci, ps_ind, oat)
     h = 1e-3

@@ -60,14 +60,22 @@ def _detail(s):
             "naive_average_bias_kt": (s.naive_tas_mps - s.tas_mps) / KT_TO_MPS,
             "pressure_alt_ft": m_to_ft(s.pressure_alt_m), "oat_c": s.oat_k - 273.15,
             "qc_pa": s.qc_pa, "dp_static_pa": s.qc_pa - s.qci_pa, "vc_kt": s.vc_kt,
-            "residuals_kt": list(s.residuals_mps / KT_TO_MPS)}
+            "residuals_kt": list(s.residuals_mps / KT_TO_MPS),
+            "tas_offsets_kt": list(_offsets(s) / KT_TO_MPS)}
+
+
+def _offsets(s):
+    """Each leg's TAS less the point's (zero for a solution made without them)."""
+    return np.zeros(s.legs.size) if s.tas_offsets_mps is None else s.tas_offsets_mps
 
 
 def legs_json(legs, points, fit, notes):
-    """The result as a JSON-ready dict: source, points, points_detail, global, warnings."""
+    """The result as a JSON-ready dict: source, n_legs, temperature (the column the OAT came
+    from), points, points_detail, global, warnings."""
     from pitotcal.io.jsonfile import json_ready
 
     return json_ready({"source": legs.source, "n_legs": legs.n,
+                       "temperature": getattr(legs, "temperature", "oat_c"),
                        "points": [_point_row(s) for s in points],
                        "points_detail": [_detail(s) for s in points],
                        "global": None if fit is None else fit.to_dict(),
@@ -80,7 +88,10 @@ def _fmt(x, spec):
 
 def legs_summary(legs, points, fit, notes):
     """The text `pitotcal legs` prints (knots, degrees true, wind FROM)."""
-    lines = [f"Legs: {legs.source} ({legs.n} legs, {len(points)} points)", "",
+    temperature = getattr(legs, "temperature", "oat_c")
+    lines = [f"Legs: {legs.source} ({legs.n} legs, {len(points)} points)"
+             + ("" if temperature in ("oat_c", "oat_k") else
+                f"; OAT from {temperature}, at each leg's true Mach"), "",
              ("Per point, the classic solution (±: 95 % half-width; bound: stated GPS accuracy, "
              "samples (the legs' own GPS scatter), leg scatter, or none):"),
              (f"  {'point':<7}{'method':<7}{'KIAS':>6}{'KTAS':>8}{'±':>6}{'wind kt':>9}"

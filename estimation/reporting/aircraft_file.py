@@ -21,6 +21,7 @@ import tomllib
 
 from pitotcal.core.errors import PitotcalError
 
+from ..identification.sensor_inputs import SENSOR_TOML_KEYS
 from .regulations import CONFIGURATIONS, STALL_SPEED_KEYS
 
 __all__ = ["AIRCRAFT_FIELDS", "aircraft_rule", "read_aircraft"]
@@ -35,6 +36,7 @@ AIRCRAFT_FIELDS = (
     ("test", "date", "Test date"), ("test", "location", "Location"),
     ("test", "pilot", "Pilot"), ("test", "engineer", "Flight-test engineer"),
     ("test", "notes", "Notes"),
+    *(("sensors", key, label) for key, _, _, label in SENSOR_TOML_KEYS),
 )
 _TABLES = tuple(dict.fromkeys(table for table, _, _ in AIRCRAFT_FIELDS))
 _KEYS = {table: [k for t, k, _ in AIRCRAFT_FIELDS if t == table] for table in _TABLES}

@@ -6,7 +6,8 @@ The budget's presentation beside the identification's own (estimation.identifica
   `dv_U_kt` and `u_dv_by_source_kt` in each `airspeed_correction` row and the top-level
   `uncertainty_budget` list (docs/interfaces.md, "Uncertainty budget");
 - `budget_summary(result, budget)`: the text printed after the summary;
-- `budget_report(result_dict)`: the report's budget tables, by source and by speed;
+- `budget_report(result_dict)`: the report's budget tables, by source (with where each input
+  came from) and by speed, and the settings (sensor class, temperature source, lever arm);
 - `plot_budget_band(ax, result, budget)`: the expanded-uncertainty band on the ΔV axes of the
   calibration figure (`IdentificationResult.plot` returns the figure; its first axes).
 """
@@ -28,7 +29,8 @@ SOURCE_LABELS = {"statistical": ("Statistical (the fit's 2σ / 2)", "stat"),
                  "gps_latency": ("GPS latency", "lat"),
                  "probe_lever_arm": ("Probe lever arm", "arm"),
                  "qc_scale": ("Impact-pressure transducer scale", "scale"),
-                 "qc_offset": ("Impact-pressure transducer offset", "offs")}
+                 "qc_offset": ("Impact-pressure transducer offset", "offs"),
+                 "static_pressure": ("Static-pressure transducer", "ps")}
 _HEADS = {k: short for k, (_, short) in SOURCE_LABELS.items()}
 
 
@@ -62,12 +64,27 @@ def budget_summary(result, budget):
         terms = "".join(_num(budget.terms_kt[n][i], 7, 3) for n in names)
         lines.append(f"  {v:7.1f}{budget.statistical_kt[i]:7.3f}{terms}"
                      f"{_num(budget.combined_kt[i], 7, 3)}")
-    lines += ["", f"  {'source':<20}{'input u':>14}{'max u(ΔV) kt':>15}"]
+    lines += ["", f"  {'source':<20}{'input u':>14}{'max u(ΔV) kt':>15}  from"]
     for row in budget.to_list():
         given = (f"{row['u_input']:.4g} {row['unit']}" if "u_input" in row
                  else "(2σ / 2)")
-        lines.append(f"  {row['source']:<20}{given:>14}{_num(row['u_dv_kt'], 15, 3)}")
+        lines.append(f"  {row['source']:<20}{given:>14}{_num(row['u_dv_kt'], 15, 3)}"
+                     + (f"  {row['origin']}" if row.get("origin") else ""))
+    lines += [f"  {r['input']}: {_value(r)} ({r['origin']})" for r in budget.input_list
+              if r["input"] in _SETTINGS]
     return "\n".join(lines)
+
+
+# the inputs that are no uncertainty, listed under the budget's table, in words
+_SETTINGS = {"sensor_class": "Sensor class", "oat_source": "Temperature source",
+             "probe_arm_m": "Probe lever arm corrected in the data"}
+
+
+def _value(row):
+    """An input list row's value with its unit."""
+    value = row.get("value")
+    text = f"{value:g}" if isinstance(value, (int, float)) else str(value)
+    return f"{text} {row.get('unit', '')}".strip()
 
 
 def _num(x, width, digits):
@@ -95,11 +112,16 @@ def budget_report(result):
         if per and (b.get("u_dv_kt") or 0.0) >= 5e-4:        # a zero term has no largest
             at = max(per, key=lambda r: r["u_dv_by_source_kt"].get(b["source"], -1.0))["vi_kt"]
         sources.append({"label": source_label(b.get("source", "")), "input": given,
-                        "u_max": b.get("u_dv_kt"), "vi_at_max": at})
+                        "u_max": b.get("u_dv_kt"), "vi_at_max": at,
+                        "origin": b.get("origin", "")})
     by_speed = [{"vi": r["vi_kt"], "u": [r["u_dv_by_source_kt"].get(n) for n in names],
                  "U": r.get("dv_U_kt")} for r in per]
     heads = [SOURCE_LABELS.get(n, (n, n))[1] for n in names]
-    return {"sources": sources, "heads": heads, "by_speed": by_speed}
+    settings = [{"input": _SETTINGS[r["input"]], "value": _value(r),
+                 "origin": r.get("origin", "")}
+                for r in result.get("budget_inputs") or []
+                if isinstance(r, dict) and r.get("input") in _SETTINGS]
+    return {"sources": sources, "heads": heads, "by_speed": by_speed, "settings": settings}
 
 
 def plot_budget_band(ax, result, budget):

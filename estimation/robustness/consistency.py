@@ -6,12 +6,19 @@ coefficients bend to absorb it. At the global optimum the residual is close to l
 unknowns, so the test adds one regressor, a change of scale from t0 on, dr/ds = q_ci 1[t >=
 t0], to the output sensitivities and refits by one linear step: its coefficient s is the
 fraction by which q_ci changed at t0, and s / sigma_s, with sigma_s from the colored-residual
-covariance of the augmented fit, is standard normal when the calibration is one. t0 is
-scanned over `ONSETS` of the record and the threshold is Bonferroni over the scan, so a clean
-flight is flagged at most at the rate `ALPHA` (measured: docs/measured.md).
+covariance of the augmented fit, is close to standard normal when the calibration is one.
+Beside the step, a ramp q_ci (t - t0)+ / (t_end - t0) takes a gradual change (a blockage
+draining, ice growing). t0 is scanned over `ONSETS`, the whole record; the threshold is
+Bonferroni over both kinds of the scan plus `MARGIN` for the noise model's heavier tails, or
+Student's t at the noise model's degrees of freedom where that is larger (`t_bound`: a record
+only a few turbulence correlation times long), so a clean flight is flagged at about the rate
+`ALPHA` or less (measured: docs/measured.md). A q_ci that ends low against the GPS, beyond
+the record's own wander, is named too (`tail_warning`). A large fall from an onset in the
+second half is a collapse (`collapse_onset_s`): the identification removes that tail and says
+so.
 
 The same covariance says what the test cannot see: a step smaller than
-(threshold + z_POWER) sigma_s is missed more often than 1 - `POWER`, and the fit absorbs it
+(bound + z_POWER) sigma_s is missed more often than 1 - `POWER`, and the fit absorbs it
 by moving the coefficients. When that move shifts ΔV beyond the reported 2-sigma band
 somewhere in the flown range, the maneuver cannot tell such a change from the calibration
 (on a one-way speed sweep a scale step from mid-flight is nearly a change of the speed
@@ -27,13 +34,30 @@ from pitotcal.core.models import delta_v_kt, delta_v_kt_where_defined, get_model
 from ..uncertainty.covariance import colored_covariance
 from ..uncertainty.residual_noise import block_means
 
-__all__ = ["ALPHA", "HIDDEN_RATIO", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
-           "hidden_warning", "step_test"]
+__all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "KINDS", "MARGIN", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
+           "TAIL_SIGMAS", "TAIL_WINDOW_S", "collapse_onset_s", "hidden_bound", "hidden_warning",
+           "step_test", "tail_warning"]
 
-# Onsets scanned, as fractions of the record: at least a fifth of it on each side.
-ONSETS = np.linspace(0.2, 0.8, 13)
+# Onsets scanned, as fractions of the record, every 3 % (finer costs threshold: the Bonferroni
+# bound grows with the number of alternatives): from a fifth of the record, as a change before
+# it leaves too few samples to be told from the start's own transients (in 3 m/s turbulence a
+# step from 2 % of the record flags every clean simulated flight), to its last 2 % (a
+# blockage in the last minute of a four-minute flight is the late fault to catch).
+ONSETS = np.linspace(0.2, 0.98, 27)
+# The alternatives tested at each onset: a step of q_ci's scale, and a ramp (q_ci falling or
+# rising steadily from the onset on, as a draining blockage or icing does).
+KINDS = ("step", "ramp")
+# The onsets whose missed step is stated (`hidden_warning`): up to 80 % of the record. A change
+# later than that leaves one calibration for most of the record; its smallest detected size,
+# from a few samples, is large and says nothing about the maneuver.
+HIDDEN_LAST_ONSET = 0.8
 # The false-flag rate aimed at on a consistent flight.
 ALPHA = 0.01
+# Standard deviations added to the Gaussian Bonferroni bound: the step's colored sigma comes
+# from a one-exponential noise model fitted to a record only some 10-20 turbulence correlation
+# times long, so z has heavier tails than the normal (200 clean return-sweep flights in
+# 0.5 m/s turbulence: 7 beyond the bound 3.74, 3.5 %; 2 beyond 4.24, 1 %: docs/measured.md).
+MARGIN = 0.5
 # The detection probability at which the smallest detected step is stated.
 POWER = 0.95
 # Hidden when the step detected at POWER moves ΔV by more than this many times its 2-sigma
@@ -41,7 +65,31 @@ POWER = 0.95
 # detected at (threshold + z_POWER) sigma_s = 5.0 sigma_s and leaves the fit halfway, at about
 # 2.5 bands; a one-way sweep hides it at 4-6 (docs/measured.md).
 HIDDEN_RATIO = 3.0
-# ... and by more than this, kt: below what an airspeed indicator shows.
+# A flagged fall of q_ci at least this large by the end of the record, from an onset in its
+# second half, is a collapse (a blocked pitot draining, ice closing the inlet): q_ci 20 % low
+# is V_i 11 % low, far beyond any calibration, and the record's tail is removed.
+COLLAPSE_FRACTION = 0.2
+# ... and so is a record whose q_ci ends, over its last `COLLAPSE_WINDOW_S`, below this
+# fraction of the impact pressure the GPS and the fitted wind give (against its median over
+# the record), whatever the scan's z: V_i 29 % low, a gust of 10 m/s held for seconds at 70 kt,
+# four sigma of 3 m/s turbulence; a draining blockage reaches it in a drain time or so.
+COLLAPSE_RATIO = 0.5
+COLLAPSE_WINDOW_S = 5.0
+# ... provided the fall is this many times the smoothed ratio's own spread over the record
+# (robust std): on a slow aircraft in strong turbulence the smoothed ratio of a clean flight
+# wanders to 0.5 (30-45 kt in 3 m/s gusts), on the T-2 maneuver its spread is ~0.02.
+COLLAPSE_SIGMAS = 6.0
+# A record whose q_ci ends low, over its last `TAIL_WINDOW_S`, by more than `TAIL_SIGMAS` of
+# the spread of that window's running mean over the record and by more than `TAIL_MIN_FALL`
+# is named (`tail_warning`): a late icing ramp of 5-7 kt/min over the last 20 % of a return
+# sweep in 0.5 m/s turbulence has colored step z of -1 to -2.5 and pulls the table's low end
+# 3-4 sigma, while its tail stands 2-6 spreads low; 180 clean flights: at most 2.5
+# (docs/measured.md).
+TAIL_WINDOW_S = 10.0
+TAIL_SIGMAS = 4.0
+TAIL_MIN_FALL = 0.02
+# A hidden step (`HIDDEN_RATIO`) also moves ΔV by more than this, kt: below it no airspeed
+# indicator shows it.
 MIN_SHIFT_KT = 0.1
 # The noise model of the step's variance: the identification's own (several time scales).
 _WINDOW = "exponential"
@@ -62,7 +110,73 @@ def check(flight, result, air_data):
     step_note, details = step_test(flight, result, air_data)
     jump_note, details["jump"] = jump_test(flight)
     hidden = None if jump_note else hidden_warning(flight.source, details)
-    return tuple(w for w in (step_note, jump_note, hidden) if w), details
+    raw, width = _ratio(flight, result, air_data)
+    ratio = _running(raw, width(COLLAPSE_WINDOW_S), median=True)
+    healthy = np.flatnonzero(ratio >= 0.95)
+    details.update(end_ratio=float(ratio[-1]), ratio_spread=_robust_std(ratio),
+                   healthy_until_s=float(flight.time_s[healthy[-1]] if healthy.size
+                                         else flight.time_s[0]))
+    details["tail_drift"] = _tail_drift(raw, width(TAIL_WINDOW_S))
+    drift = None if step_note or jump_note else tail_warning(flight.source, details,
+                                                             flight.time_s[-1])
+    return tuple(w for w in (step_note, jump_note, hidden, drift) if w), details
+
+
+def _robust_std(x):
+    return 1.4826 * float(np.median(np.abs(x - np.median(x))))
+
+
+def _running(x, width, median=False):
+    """A running median or mean of `width` samples (centred, the ends held)."""
+    from scipy.ndimage import median_filter, uniform_filter1d
+
+    if median:
+        return median_filter(x, size=width, mode="nearest")
+    return uniform_filter1d(x, size=width, mode="nearest")
+
+
+def _tail_drift(raw, width):
+    """The q_ci ratio's mean over the record's last `width` samples against the spread of its
+    running mean over the whole record (`TAIL_WINDOW_S`): a late fall the scan's colored sigma
+    does not resolve, measured against the record's own wander at that scale."""
+    end = float(np.mean(raw[-width:]))
+    spread = max(_robust_std(_running(raw, width)), 1e-12)
+    sigmas = (1.0 - end) / spread
+    return {"window_s": TAIL_WINDOW_S, "end_ratio": end, "sigmas": float(sigmas),
+            "flagged": bool(sigmas > TAIL_SIGMAS and 1.0 - end > TAIL_MIN_FALL)}
+
+
+def tail_warning(source, details, end_s):
+    """The warning of a record whose q_ci ends low against the GPS (`_tail_drift`), or None."""
+    drift = details.get("tail_drift") or {}
+    if not drift.get("flagged"):
+        return None
+    return (f"{source}: q_ci drifts low at the end of the record: over its last "
+            f"{drift['window_s']:.0f} s (to {end_s:.0f} s) it reads "
+            f"{100 * drift['end_ratio']:.1f}% of the impact pressure the GPS and the fitted "
+            f"wind give (median over the record: 100%), {drift['sigmas']:.1f} times that "
+            "ratio's own spread over the record: icing, a draining blockage or a leak late "
+            "in the flight? The calibration may be pulled by the tail; fit the record "
+            "without it (`end_s`) and compare")
+
+
+def _ratio(flight, result, air_data):
+    """(the ratio of q_ci to the impact pressure of GPS and fitted wind, against its median
+    over the record, at each sample; the number of samples in a window of so many seconds)."""
+    from pitotcal.core.measurement import as_air, tas_squared
+
+    ch = flight_channels(flight, result.gps_noise_std_mps, air_data)
+    wind_n, wind_e = result.internal_params[-2], result.internal_params[-1]
+    qc = as_air(ch.air).qc_pa(tas_squared(ch.vn, ch.ve, wind_n, wind_e, ch.vd2))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.asarray(ch.qci, float) / np.asarray(qc, float)
+    ratio = np.where(np.isfinite(ratio), ratio, 1.0)
+    dt = float(np.median(np.diff(flight.time_s))) if flight.n > 1 else 1.0
+
+    def width(seconds):
+        return int(np.clip(round(seconds / max(dt, 1e-9)), 1, flight.n))
+
+    return ratio / max(float(np.median(ratio)), 1e-12), width
 
 
 def step_test(flight, result, air_data):
@@ -82,8 +196,9 @@ def step_test(flight, result, air_data):
         Names the onset and the size when |z| exceeds the threshold (`hidden_warning` says
         when a step the test would miss moves ΔV by several bands).
     details : dict
-        ``onset_s``, ``step`` (fraction, q_ci low when positive), ``z``, ``threshold``,
-        ``alpha``, ``flagged``; ``undetected`` (the onset where a missed step matters most:
+        ``onset_s``, ``kind``, ``step`` (fraction, q_ci low when positive), ``z``,
+        ``threshold`` (`t_bound` at ``dof`` when larger than the normal bound plus `MARGIN`),
+        ``dof``, ``alpha``, ``flagged``; ``undetected`` (the onset where a missed step matters most:
         ``onset_s``, ``step`` the smallest step detected at ``power``, ``dv_shift_kt`` the
         largest ΔV shift it causes, at ``vi_kt``, against ``dv_2sigma_kt`` there,
         ``k_shift_sigma`` the coefficients' shift in their own covariance) and ``hidden``
@@ -97,25 +212,102 @@ def step_test(flight, result, air_data):
     # each onset at the first sample from its fraction of the record on (never inside a gap)
     onsets = t[np.searchsorted(t, t[0] + ONSETS * (t[-1] - t[0]))]
     first = np.r_[0, np.searchsorted(t, onsets)]   # the first: the whole record
-    threshold = float(normal_isf(ALPHA / (2.0 * ONSETS.size)))
-    scan = _scan(jac, r, ch.qci, first, threshold)
+    bound = float(normal_isf(ALPHA / (2.0 * len(KINDS) * ONSETS.size)))
+    scan = _scan(jac, r, _Alternatives(np.asarray(ch.qci, float), t, first), bound + MARGIN)
+    threshold = max(bound + MARGIN, t_bound(ALPHA / (2.0 * len(KINDS) * ONSETS.size),
+                                            scan["dof"]))
     z = scan["beta"] / scan["sigma"]
     best = scan["best"]
-    details = {"onset_s": float(onsets[best]), "step": float(-scan["beta"][best]),
-               "z": float(z[best]), "threshold": threshold, "alpha": ALPHA,
+    kind, at = KINDS[best // ONSETS.size], best % ONSETS.size
+    details = {"onset_s": float(onsets[at]), "kind": kind, "step": float(-scan["beta"][best]),
+               "z": float(z[best]), "threshold": threshold, "alpha": ALPHA, "dof": scan["dof"],
                "flagged": bool(abs(z[best]) > threshold)}
-    hidden = _undetected(result, model, onsets, scan, threshold + float(normal_isf(1 - POWER)))
+    # the maneuver's geometry: the Gaussian bound of a scan of the steps it states alone
+    # (`hidden_bound`), as the margin is for the noise model's tails
+    n_mid = int(np.sum(ONSETS <= HIDDEN_LAST_ONSET + 1e-9))
+    hidden = _undetected(result, model, onsets[:n_mid], scan,
+                         hidden_bound(n_mid) + float(normal_isf(1 - POWER)))
     details.update(undetected=hidden, hidden=bool(
         hidden["dv_shift_kt"] > max(HIDDEN_RATIO * hidden["dv_2sigma_kt"], MIN_SHIFT_KT)))
     if details["flagged"]:
-        beta = scan["beta"][best]
-        side = "low" if beta < 0 else "high"
-        return (f"{flight.source}: the calibration changes during the flight: from about "
-                f"t = {onsets[best]:.0f} s to the end ({t[-1]:.0f} s) q_ci reads "
-                f"{100 * abs(beta):.1f}% {side} against before (z = {z[best]:+.1f}, beyond "
-                f"{threshold:.1f}): a leak, icing, blockage or drift? One calibration for the "
-                "whole record does not hold, and its bounds are not honest"), details
+        return _change_warning(flight.source, details, t[-1]), details
     return None, details
+
+
+def t_bound(tail, dof):
+    """The |z| bound of two-sided probability 2 `tail` when the sigma comes from a noise model
+    fitted with `dof` degrees of freedom (`ColoredCovariance.dof`: one per few correlation
+    times of the residuals): Student's t quantile, over the t widening at 2 sigma that the
+    colored covariance already carries; the normal one for infinite `dof`.
+
+    A record only a few turbulence correlation times long (a slow aircraft in strong
+    turbulence: 30-45 kt in 3 m/s gusts, correlation times of 20-30 s in a 240 s record)
+    leaves the noise model's variance uncertain, and z = coefficient / sigma then has the
+    t's heavy tails, not the normal's (docs/measured.md).
+    """
+    from scipy.stats import t as student_t
+
+    from pitotcal.core.information import student_t_widening
+
+    if not np.isfinite(dof):
+        return float(normal_isf(tail))
+    v = max(float(dof), 3.0)        # as the covariance's own widening takes it
+    return float(student_t.isf(tail, v)) / student_t_widening(v)
+
+
+def hidden_bound(n_onsets):
+    """The |z| bound of the hidden-step statement: Bonferroni over a scan of steps alone at
+    `n_onsets` onsets.
+
+    The statement is about the maneuver, whether it can tell a change of scale from
+    mid-flight (a leak) from the calibration; the ramps and the onsets after
+    `HIDDEN_LAST_ONSET`, scanned for late and gradual faults, raise the detection test's bound
+    (from 3.49 to 3.74 sigma) but not what the maneuver can tell: at 3.74 a return sweep in
+    1 m/s turbulence, which tells a mid-flight step from the calibration, would be said to
+    hide one on 7 of 50 clean flights, at 3.49 on 1 of 50 (docs/measured.md).
+    """
+    return float(normal_isf(ALPHA / (2.0 * max(int(n_onsets), 1))))
+
+
+def _change_warning(source, details, end_s):
+    """The warning of a flagged change (`step_test`'s details)."""
+    beta = -details["step"]
+    side = "low" if beta < 0 else "high"
+    if details["kind"] == "ramp":
+        how = (f"from about t = {details['onset_s']:.0f} s on q_ci drifts steadily "
+               f"{'down' if beta < 0 else 'up'}, {100 * abs(beta):.1f}% {side} by the end "
+               f"({end_s:.0f} s)")
+        cause = "gradual blockage, icing or a drift?"
+    else:
+        how = (f"from about t = {details['onset_s']:.0f} s to the end ({end_s:.0f} s) q_ci "
+               f"reads {100 * abs(beta):.1f}% {side} against before")
+        cause = "a leak, icing, blockage or drift?"
+    return (f"{source}: the calibration changes during the flight: {how} "
+            f"(z = {details['z']:+.1f}, beyond {details['threshold']:.1f}): {cause} One "
+            "calibration for the whole record does not hold, and its bounds are not honest")
+
+
+def collapse_onset_s(details, time_s):
+    """Where a collapsed tail of q_ci starts (`check`'s details of the record `time_s`), or
+    None.
+
+    A collapse: a flagged fall of at least `COLLAPSE_FRACTION` from an onset in the second
+    half of the record, or a record whose smoothed q_ci ends below `COLLAPSE_RATIO` of what
+    the GPS gives (``end_ratio``), by more than `COLLAPSE_SIGMAS` of the smoothed ratio's
+    spread (``ratio_spread``), from where it last stood at 0.95 of it (``healthy_until_s``). The cut is one
+    onset of the scan earlier: the scan places an onset only to its grid, and the samples
+    lost before it were healthy."""
+    t0, t1 = float(time_s[0]), float(time_s[-1])
+    onsets = []
+    if details.get("flagged") and details["step"] >= COLLAPSE_FRACTION \
+            and details["onset_s"] >= t0 + 0.5 * (t1 - t0):
+        onsets.append(details["onset_s"])
+    fall = 1.0 - details.get("end_ratio", 1.0)
+    if fall > 1.0 - COLLAPSE_RATIO and fall > COLLAPSE_SIGMAS * details.get("ratio_spread", 0.0):
+        onsets.append(details["healthy_until_s"])
+    if not onsets:
+        return None
+    return min(onsets) - (ONSETS[1] - ONSETS[0]) * (t1 - t0)
 
 
 def hidden_warning(source, details):
@@ -145,31 +337,86 @@ def _first_order(hidden):
             "Mach range of the pitot relations)")
 
 
-def _scan(jac, r, qci, first, threshold):
-    """The augmented fit [S, g_k] of every onset k (g_k = q_ci 1[i >= first_k], the first
-    over the whole record): step coefficients, their sigmas, and the parameter shift per unit
-    step of the plain fit that absorbs g_k (and of a change of scale over the whole record,
-    `shift_all`).
+class _Alternatives:
+    """The alternatives' columns, never all formed: a change of scale over the whole record
+    (index 0), a step g_k = q_ci 1[i >= first_k] and a ramp q_ci (t - t_k)+ / (t_end - t_k)
+    at each onset k (a gradual blockage or icing, q_ci falling from t_k on; scaled so its
+    coefficient is the fraction changed by the end of the record).
 
-    The steps' Gram entries are tail sums (g_k . g_l = sum of q_ci^2 from max(first_k, first_l)
-    on), so no step column is formed. The white-noise sigmas come first: a step is a
-    low-frequency regressor, so under the positively correlated residuals of flight its
-    colored sigma is larger, and where no white-noise |z| exceeds the threshold no colored one
-    does. The noise-model fit, the test's main cost, is spent only on the onset of the largest
-    white-noise |z| when it is over the threshold: fitted to the residuals of the augmented
-    fit there (on the plain fit's residuals a real step would count as noise and hide itself),
-    the white-noise variance a floor.
+    Their products with the data and with each other are tail sums (from the later onset of
+    the two on), so memory stays that of a few columns whatever the number of onsets."""
+
+    def __init__(self, qci, t, first):
+        self.qci, self.first, self.n = qci, first, qci.size
+        self.t = t - t[0]                          # relative: the tail sums keep their digits
+        self.tk = self.t[first]
+        self.tk[0] = 0.0
+        span = max(float(self.t[-1]), 1e-12)
+        self.scale = np.r_[np.ones(first.size),
+                           1.0 / np.maximum(self.t[-1] - self.tk[1:], 1e-3 * span)]
+        self.on = np.r_[first, first[1:]]          # each column's first sample
+        self.ramp = np.r_[np.zeros(first.size, bool), np.ones(first.size - 1, bool)]
+
+    def column(self, j):
+        g = np.where(np.arange(self.n) >= self.on[j], self.qci, 0.0)
+        if self.ramp[j]:
+            g = g * (self.t - self.tk[self._onset(j)]) * self.scale[j]
+        return g
+
+    def _onset(self, j):
+        return j if j < self.first.size else j - self.first.size + 1
+
+    def dot(self, x):
+        """x.T @ G for x of shape (n,) or (n, p): (m,) or (m, p)."""
+        x = x.reshape(self.n, -1)
+        q0 = _tail(x * self.qci[:, None])[self.on]
+        q1 = _tail(x * (self.qci * self.t)[:, None])[self.on]
+        tk = np.array([self.tk[self._onset(j)] for j in range(self.on.size)])[:, None]
+        out = np.where(self.ramp[:, None], (q1 - tk * q0) * self.scale[:, None], q0)
+        return out if out.shape[1] > 1 else out[:, 0]
+
+    def gram(self):
+        """G.T @ G."""
+        q2 = self.qci * self.qci
+        s0, s1, s2 = (_tail(q2 * self.t ** e)[self.on] for e in range(3))
+        m = self.on.size
+        later = np.where(self.on[:, None] >= self.on[None, :], np.arange(m)[:, None],
+                         np.arange(m)[None, :])
+        tk = np.array([self.tk[self._onset(j)] for j in range(m)])
+        a0, a1, a2 = s0[later], s1[later], s2[later]
+        ri, rj = self.ramp[:, None], self.ramp[None, :]
+        ti, tj = tk[:, None], tk[None, :]
+        g = np.where(ri & rj, a2 - (ti + tj) * a1 + ti * tj * a0,
+                     np.where(ri, a1 - ti * a0, np.where(rj, a1 - tj * a0, a0)))
+        return g * np.outer(self.scale, self.scale)
+
+
+def _tail(x):
+    """Sums from each row to the end (along the first axis)."""
+    return np.cumsum(x[::-1], axis=0)[::-1]
+
+
+def _scan(jac, r, g, threshold):
+    """The augmented fit [S, g_k] of every alternative column g_k of `g` (`_Alternatives`, the
+    first a change of scale over the whole record): their coefficients, sigmas, and the
+    parameter shift per unit coefficient of the plain fit that absorbs g_k.
+
+    The white-noise sigmas come first: a step or a ramp is a low-frequency regressor, so
+    under the positively correlated residuals of flight its colored sigma is larger, and
+    where no white-noise |z| exceeds the threshold no colored one does. The noise-model fit,
+    the test's main cost, is spent only on the alternative of the largest white-noise |z|
+    when it is over the threshold: fitted to the residuals of the augmented fit there (on
+    the plain fit's residuals a real step would count as noise and hide itself), the
+    white-noise variance a floor.
     """
     n, p = jac.shape
-    m = first.size
-    q2, jq, rq = (_tail(qci * qci)[first], _tail(jac * qci[:, None])[first],
-                  _tail(r * qci)[first])
+    m = g.on.size
     gram = np.empty((p + m, p + m))
     gram[:p, :p] = jac.T @ jac
-    gram[:p, p:] = jq.T
-    gram[p:, :p] = jq
-    gram[p:, p:] = q2[np.maximum.outer(np.arange(m), np.arange(m))]
-    xr, rr = np.r_[jac.T @ r, rq], float(r @ r)
+    gram[p:, :p] = g.dot(jac)
+    gram[:p, p:] = gram[p:, :p].T
+    gram[p:, p:] = g.gram()
+    xr, rr = np.r_[jac.T @ r, g.dot(r)], float(r @ r)
     cols = [np.r_[np.arange(p), p + k] for k in range(m)]
     inv_k = [np.linalg.inv(gram[np.ix_(idx, idx)]) for idx in cols]
     coef = [mk @ xr[idx] for mk, idx in zip(inv_k, cols)]
@@ -178,28 +425,28 @@ def _scan(jac, r, qci, first, threshold):
     s2 = np.array([max(rr - c @ xr[idx], 0.0) for c, idx in zip(coef, cols)]) / max(n - p - 1, 1)
     sigma = np.sqrt(s2 * np.array([mk[-1, -1] for mk in inv_k]))
     plain = sigma.copy()
+    dof = float("inf")
     best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
     if abs(beta[best]) > threshold * sigma[best]:
-        x = np.column_stack([jac, np.where(np.arange(n) >= first[best], qci, 0.0)])
+        x = np.column_stack([jac, g.column(best)])
         # on block means of `b` samples: the regressors are smooth over a block (the step is
         # one jump in ~N / b blocks) and the noise model is fitted to what the blocks keep, at
         # a cost independent of N
         b = max(1, int(np.ceil(n / _BLOCKS)))
         xb = block_means(x, b)
         eb = block_means(r - x @ coef[best], b)
-        cov = colored_covariance(xb, eb, window=_WINDOW, velocity=xb[:, p - 2:p]).covariance
-        sigma[best] = np.sqrt(max(cov[-1, -1], sigma[best] ** 2))
+        colored = colored_covariance(xb, eb, window=_WINDOW, velocity=xb[:, p - 2:p])
+        white, var = sigma[best] ** 2, float(colored.covariance[-1, -1])
+        sigma[best] = np.sqrt(max(var, white))
+        # Welch-Satterthwaite: only the part beyond the white noise's is uncertain
+        if var > white:
+            dof = float(colored.dof) * (var / (var - white)) ** 2
     m_inv = np.linalg.inv(gram[:p, :p])
     # how far the plain fit moves per unit of q_ci low (s = -beta): r is q_ci - predicted
     shift = (m_inv @ gram[:p, p:]).T
-    return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:],
+    return {"best": best - 1, "beta": beta[1:], "sigma": sigma[1:], "plain": plain[1:], "dof": dof,
             "shift": shift[1:],
             "shift_all": shift[0], "cov_plain": float(np.mean(s2[1:])) * m_inv}
-
-
-def _tail(x):
-    """Sums from each row to the end (along the first axis)."""
-    return np.cumsum(x[::-1], axis=0)[::-1]
 
 
 def _dv_shift_kt(model, k_shifted, vi_kt, dv_fit_kt, first_order_kt, air_data):

@@ -4,7 +4,8 @@ The T-2 maneuver (planner defaults: 70-100 KCAS, 244 m, 5 m/s wind) is flown wit
 compressible truth (the static error in the logged ps_pa) in calm air, light and moderate
 turbulence; each flight is identified (the default compressible fit) and its uncertainty budget computed
 with the documented default inputs (estimation.identification.budget.BudgetInputs) and a wingtip probe 1 m
-out (`probe_arm_m` = 1; 0 for a probe on the centre line). The table has,
+out that the data were not corrected for (`probe_arm_m` = 1, counted wholly; 0 for a probe on the
+centre line). The table has,
 per flight, the largest standard uncertainty of ΔV over the flown range for each source; the
 figure sets them beside each other per turbulence level. The calm-air statistical part is what
 a Monte Carlo of our own simulator shows; the Type B terms are what it cannot.

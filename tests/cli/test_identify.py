@@ -296,9 +296,12 @@ def test_budget_in_summary_json_and_no_budget(flight_csv, tmp_path, capsys):
     assert budget[0]["source"] == "statistical"
     assert [b["source"] for b in budget[1:]] == ["oat", "humidity", "gps_velocity_bias",
                                                  "gps_latency", "probe_lever_arm", "qc_scale",
-                                                 "qc_offset"]
+                                                 "qc_offset", "static_pressure"]
     by = {b["source"]: b for b in budget}
-    assert by["oat"]["u_input"] == 2.0 and by["probe_lever_arm"]["u_dv_kt"] > 0.01
+    assert by["oat"]["u_input"] == 2.0 and by["oat"]["origin"] == "flag --u-oat-k"
+    # the arm is corrected in the data: the term is its own 10 %
+    assert by["probe_lever_arm"]["u_input"] == pytest.approx(0.1)
+    assert by["probe_lever_arm"]["u_dv_kt"] > 0.001 and d["reading"]["probe_arm_m"] == 1.0
     for row in d["airspeed_correction"]:
         # U (k = 2) is at least the statistical 2σ and at most 2σ + 2 Σ u_j
         assert row["dv_2sigma_kt"] <= row["dv_U_kt"]
@@ -343,8 +346,46 @@ def test_json_is_the_librarys_record(flight_csv, tmp_path, capsys):
     capsys.readouterr()
     written = json.loads(out.read_text())
     flight = read_flight(path, end_s=250.0)
-    record = json.loads(json.dumps(identify(flight, budget=BudgetInputs(u_oat_k=2.0)).to_dict()))
+    given = BudgetInputs(u_oat_k=2.0, origins={"u_oat_k": "flag --u-oat-k"})
+    record = json.loads(json.dumps(identify(flight, budget=given).to_dict()))
     del written["timing_s"], record["timing_s"]
     assert written == record
     assert written["reading"]["end_s"] == 250.0 and written["source"] == str(path)
-    assert {"noise_model", "gps_error", "reading", "uncertainty_budget"} <= set(written)
+    assert {"noise_model", "gps_error", "reading", "uncertainty_budget",
+            "budget_inputs"} <= set(written)
+
+
+def test_sensor_class_from_the_aircraft_file_and_flags(flight_csv, tmp_path, capsys):
+    """The class and inputs of the aircraft file's [sensors], a flag over them, and the JSON's
+    `budget_inputs` saying where each came from; the text lists them too."""
+    path, _ = flight_csv
+    toml = tmp_path / "a.toml"
+    toml.write_text('[aircraft]\ntype = "T-2"\n[sensors]\nclass = "mems-uav"\n'
+                    'u_ps_pa = 80\nu_oat_k = 3.0\n')
+    out = tmp_path / "s.json"
+    assert main(["identify", str(path), "--aircraft", str(toml), "--u-oat-k", "2",
+                 "--oat-source", "user", "--json", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "sensor_class: mems-uav (aircraft file sensors.class)" in text
+    rows = {r["input"]: r for r in json.loads(out.read_text())["budget_inputs"]}
+    assert rows["sensor_class"]["value"] == "mems-uav"
+    assert rows["u_ps_pa"] == {"input": "u_ps_pa", "value": 80.0, "unit": "Pa",
+                               "origin": "aircraft file sensors.u_ps_pa"}
+    assert rows["u_oat_k"]["value"] == 2.0 and rows["u_oat_k"]["origin"] == "flag --u-oat-k"
+    assert rows["oat_source"]["value"] == "user"
+    assert rows["u_qc_scale"] == {"input": "u_qc_scale", "value": 0.015, "unit": "1",
+                                  "origin": "default of class mems-uav"}
+
+
+@pytest.mark.parametrize("text, shown", [
+    ('[sensors]\nclass = "hobby"\n', "sensors.class 'hobby' is not one of"),
+    ('[sensors]\nu_ps_pa = -5\n', "sensors.u_ps_pa"),
+    ('[sensors]\nu_ps_pb = 5\n', "did you mean sensors.u_ps_pa"),
+])
+def test_bad_sensor_table_refused(flight_csv, tmp_path, capsys, text, shown):
+    path, _ = flight_csv
+    toml = tmp_path / "bad.toml"
+    toml.write_text(text)
+    assert main(["identify", str(path), "--aircraft", str(toml)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and shown in err and "--aircraft" in err

@@ -154,3 +154,31 @@ def test_params_help_says_the_px4_file_uses_the_logs_parameter_name(capsys):
     assert (f"parameter file with {ARDUPILOT_RATIO}, for a PX4 log a QGroundControl parameter "
             f"file with the scale parameter the log has ({' or '.join(PX4_SCALES)}; "
             f"{PX4_SCALES[0]} when it has neither)") in text
+
+
+def test_the_parameter_is_recommended_from_the_data_corrected_for_the_lever_arm(tmp_path,
+                                                                                capsys):
+    """A probe 1 m out on the wing in steady turns reads q_ci scaled by (1 - r y / V)², which
+    varies with V: uncorrected, no single ARSPD_RATIO fits (exit 2); with --probe-arm-m the
+    recommendation is the centre-line probe's to 0.05 % (the offset's misfit is judged against
+    a tight --misfit-tolerance-kt: its 0.07 kt is far below the default 1.67 kt)."""
+    import re
+
+    from pitotcal.estimation import identify
+    from pitotcal.estimation.identification.budget import lever_arm_error
+
+    flight = synthetic_flight(seed=3, n=6000, model="constant", k=(0.18,))[0]
+    offset = lever_arm_error(flight, identify(flight, model="constant"), 1.0)
+    runs = {}
+    for name, data, extra in (("clean", flight, []), ("offset", offset, ["--misfit-tolerance-kt", "0.03"]),
+                              ("corrected", offset, ["--probe-arm-m", "1"])):
+        path, out = tmp_path / f"{name}.csv", tmp_path / f"{name}.param"
+        write_flight_csv(data, path, comments={"autopilot_ARSPD_RATIO": "1.9936"})
+        status = main(["identify", str(path), "--model", "constant", "--no-budget",
+                       "--params", str(out), *extra])
+        captured = capsys.readouterr()
+        found = re.search(r"Recommended ARSPD_RATIO = ([\d.]+)", captured.out)
+        runs[name] = (status, float(found.group(1)) if found else captured.err)
+    assert runs["offset"][0] == 2 and "departs from one scale" in runs["offset"][1]
+    assert runs["clean"][0] == runs["corrected"][0] == 0
+    assert runs["corrected"][1] == pytest.approx(runs["clean"][1], rel=5e-4)

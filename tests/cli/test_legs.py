@@ -87,3 +87,47 @@ def test_bad_cell_exit_2_naming_column_and_row(tmp_path, capsys):
 def test_output_on_top_of_input_refused(capsys):
     assert main(["legs", str(EXAMPLE), "--json", str(EXAMPLE)]) == 2
     assert "would overwrite the input leg file" in capsys.readouterr().err
+
+
+def test_indicated_total_temperature_file_gives_the_static_one(tmp_path, capsys):
+    """The example's OAT turned into the indicated total temperature (tat_c) a probe of
+    recovery factor 0.8 reads at each leg's true Mach (the example's truth: Δp/q_c = 0.03 −
+    40 Pa/q_ci): with --temp-recovery 0.8 the result is the example's own to 0.01 kt (each
+    point converts at its own estimate of the position error, which its scatter moves)."""
+    import csv
+    import io
+
+    import numpy as np
+
+    from pitotcal.core import airdata
+    from pitotcal.core.units import FT_TO_M, KT_TO_MPS
+
+    lines = EXAMPLE.read_text().splitlines()
+    body = [ln for ln in lines if ln and not ln.startswith("#")]
+    rows = list(csv.DictReader(io.StringIO("\n".join(body))))
+    for r in rows:
+        qci = float(airdata.qc_from_cas_pa(float(r["ias_kt"]) * KT_TO_MPS))
+        qc = qci / (1.0 - (0.03 - 40.0 / qci))
+        ps = airdata.static_pressure_pa(float(r["pressure_alt_ft"]) * FT_TO_M) + qci - qc
+        mach = float(airdata.mach_from_qc(qc, ps))
+        t_s = float(r.pop("oat_c")) + 273.15
+        r["tat_c"] = f"{t_s * (1 + 0.8 * 0.2 * mach ** 2) - 273.15:.5f}"
+    total = tmp_path / "tat.csv"
+    with open(total, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    assert main(["legs", str(EXAMPLE), "--json", str(a)]) == 0
+    assert main(["legs", str(total), "--temp-recovery", "0.8", "--json", str(b)]) == 0
+    head = next(ln for ln in capsys.readouterr().out.splitlines()
+                if ln.startswith(f"Legs: {total}"))
+    assert head.endswith("; OAT from tat_c, recovery factor 0.8, at each leg's true Mach")
+    da, db = json.loads(a.read_text()), json.loads(b.read_text())
+    assert db["temperature"] == "tat_c, recovery factor 0.8" and da["temperature"] == "oat_c"
+    for pa, pb in zip(da["points"], db["points"]):
+        assert pb["dv_kt"] == pytest.approx(pa["dv_kt"], abs=0.01)
+        assert pb["wind_speed_kt"] == pytest.approx(pa["wind_speed_kt"], abs=0.005)
+    ka, kb = (d["global"]["parameters"]["k1"]["value"] for d in (da, db))
+    assert kb == pytest.approx(ka, abs=2e-4)
+    assert np.isfinite(db["global"]["parameters"]["k1"]["value"])

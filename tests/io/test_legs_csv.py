@@ -45,6 +45,25 @@ def test_alternative_columns_qc_and_kelvin(tmp_path):
     np.testing.assert_allclose(legs.duration_s, 60.0)
 
 
+@pytest.mark.parametrize("column, offset", [("tat_c", 0.0), ("tat_k", 273.15)])
+@pytest.mark.parametrize("recovery", [1.0, 0.8])
+def test_indicated_total_temperature_column(tmp_path, column, offset, recovery):
+    """A leg file giving the indicated total temperature: T_s = T_t / (1 + r 0.2 M²), M the
+    indicated Mach at the leg's pressure altitude (200 KIAS at 10,000 ft: M 0.363, a ram rise
+    of 7.1 K at r = 1); the LegData says which column and factor."""
+    static_k, alt_ft, ias = 268.0, 10000.0, 200.0
+    mach = float(airdata.mach_from_qc(airdata.qc_from_cas_pa(ias * KT_TO_MPS),
+                                      airdata.static_pressure_pa(alt_ft * 0.3048)))
+    assert mach == pytest.approx(0.363, abs=0.001)
+    total = static_k * (1 + recovery * 0.2 * mach ** 2) - 273.15 + offset
+    text = (f"point,ias_kt,pressure_alt_ft,{column},groundspeed_kt,track_deg\n"
+            + "".join(f"1,{ias},{alt_ft},{total:.4f},{gs},{tk}\n"
+                      for gs, tk in ((220, 0), (240, 120), (230, 240))))
+    legs = read_legs(_write(tmp_path, text), temp_recovery=recovery)
+    np.testing.assert_allclose(legs.oat_k, static_k, atol=1e-3)
+    assert legs.temperature == f"{column}, recovery factor {recovery:g}"
+
+
 def test_round_trip_of_simulated_legs(tmp_path):
     legs, _ = simulate_legs(seed=3)
     write_legs(legs, tmp_path / "sim.csv", comments=["simulated"])
@@ -64,7 +83,7 @@ HEADER = "point,ias_kt,pressure_alt_ft,oat_c,groundspeed_kt,track_deg\n"
     ("point,ias_kt,oat_c,groundspeed_kt\n1,2,3,4\n",
      "missing column pressure_alt_ft, track_deg"),
     ("point,pressure_alt_ft,groundspeed_kt,track_deg\n1,2,3,4\n",
-     r"missing column ias_kt \(or qc_pa\), oat_c \(or oat_k\)"),
+     r"missing column ias_kt \(or qc_pa\), oat_c \(or oat_k or tat_c or tat_k\)"),
     (HEADER + "1,100,3000,10,95,0\n1,abc,3000,10,95,90\n",
      r"legs.csv: column ias_kt, row 2 \(line 3\): 'abc' is not a number"),
     (HEADER + "1,100,3000,,95,0\n", r"column oat_c, row 1 \(line 2\): empty"),

@@ -106,9 +106,23 @@ def _add_budget_arguments(p):
         "uncertainty budget",
         "GUM budget of the airspeed correction: the statistical 2-sigma plus Type B inputs, "
         "each given as a standard uncertainty and propagated by re-solving the perturbed "
-        "flight; reported as the expanded uncertainty U (k = 2)")
+        "flight; reported as the expanded uncertainty U (k = 2). The defaults quoted are the "
+        "flight-test class's; --sensor-class takes another class's (docs/interfaces.md)")
     bud.add_argument("--no-budget", action="store_true",
                      help="skip the budget (up to {budget_solves} extra solves)")
+    bud.add_argument("--sensor-class", default=None, metavar="CLASS",
+                     help="the sensors' class, whose defaults fill every input not given: "
+                          "{sensor_classes} (default {default_class}, or the aircraft file's "
+                          "[sensors] class)")
+    bud.add_argument("--aircraft", metavar="AIRCRAFT.toml", default=None,
+                     help="the aircraft file (as report --aircraft): its [sensors] table "
+                          "gives the class and any input below by the same name (class, "
+                          "oat_source, u_oat_k, u_ps_pa, probe_arm_m, ...); a flag overrides it")
+    bud.add_argument("--oat-source", default=None, metavar="SOURCE",
+                     help="where the temperature came from, which sets u(OAT): {oat_sources} "
+                          "(default: what the flight says: a logged OAT is a probe, --oat-c "
+                          "user, a tat_k column total-temperature, no temperature isa, a "
+                          "pressure chip's sensor-chip)")
     for flag, metavar, text in _BUDGET_FLAGS:
         bud.add_argument(flag, type=float, default=None, metavar=metavar, help=text)
     p.help_from(_help_constants)
@@ -116,18 +130,23 @@ def _add_budget_arguments(p):
 
 # (flag, metavar, help); the default None leaves BudgetInputs' own, which the help quotes
 _BUDGET_FLAGS = (
-    ("--u-oat-k", "K", "static air temperature, K; default {u_oat_k:g}"),
+    ("--u-oat-k", "K", ("static air temperature, K; default by its source: a probe "
+                        "{u_oat_k:g} (flight-test), {u_oat_sources}")),
     ("--u-rh-percent", "PCT", ("relative humidity, %%RH; default {rh_given:g} with a humidity, "
                                "else {rh_unknown:.0f} (dry assumed, 0-100 %% rectangular)")),
     ("--u-gps-velocity-mps", "MPS", "GPS velocity bias per axis, m/s; default "
                                     "{u_gps_velocity_mps:g}"),
     ("--u-gps-latency-s", "S", "GPS-pressure time alignment, s; default {u_gps_latency_s:g}"),
     ("--probe-arm-m", "M", ("lateral offset of the pitot probe from the centre line, m "
-                            "(right wing +): turns make it see V_t - r y; default "
-                            "{probe_arm_m:g}")),
-    ("--u-qc-scale-percent", "PCT", "transducer gain, %% of reading; default "
+                            "(right wing +), corrected in the data: turns make it see "
+                            "V_t - r y; default {probe_arm_m:g}")),
+    ("--u-probe-arm-m", "M", ("the lever arm's own uncertainty, m; default {arm_fraction:g} %% "
+                              "of --probe-arm-m")),
+    ("--u-qc-scale-percent", "PCT", "differential transducer gain, %% of reading; default "
                                     "{u_qc_scale_percent:g}"),
-    ("--u-qc-offset-pa", "PA", "transducer zero offset, Pa; default {u_qc_offset_pa:g}"),
+    ("--u-qc-offset-pa", "PA", "differential transducer zero offset, Pa; default "
+                               "{u_qc_offset_pa:g}"),
+    ("--u-ps-pa", "PA", "static-pressure transducer, Pa; default {u_ps_pa:g}"),
 )
 
 
@@ -140,8 +159,17 @@ def _help_constants():
     from pitotcal.io.mavlink_live import IDLE_TIMEOUT_S
     from pitotcal.io.param_files import ARDUPILOT_RATIO, PX4_SCALES
 
-    defaults = dataclasses.asdict(budget.BudgetInputs())
+    from pitotcal.estimation.identification import sensor_inputs as si
+
+    defaults = {**dataclasses.asdict(budget.BudgetInputs()),
+                **si.CLASS_DEFAULTS[si.DEFAULT_SENSOR_CLASS]}
+    defaults["u_oat_k"] = defaults["u_oat_probe_k"]
     return {**defaults, "u_qc_scale_percent": 100.0 * defaults["u_qc_scale"],
+            "sensor_classes": ", ".join(si.SENSOR_CLASSES),
+            "default_class": si.DEFAULT_SENSOR_CLASS, "oat_sources": ", ".join(si.OAT_SOURCES),
+            "u_oat_sources": ", ".join(f"{name} {u:.3g}" for name, (_, u)
+                                       in si.OAT_SOURCES.items() if u is not None),
+            "arm_fraction": 100.0 * si.ARM_U_FRACTION,
             "rh_given": budget.RH_U_GIVEN_PCT, "rh_unknown": budget.RH_U_UNKNOWN_PCT,
             "budget_solves": 2 * len(budget.SOURCES), "ardupilot_param": ARDUPILOT_RATIO,
             "px4_params": " or ".join(PX4_SCALES), "px4_param": PX4_SCALES[0],
@@ -154,25 +182,60 @@ def _help_constants():
 # q_c of 80 kt) and the budget would be all of it, or overflow.
 BUDGET_INPUT_RANGES = {"u_oat_k": (0.0, 50.0), "u_gps_velocity_mps": (0.0, 5.0),
                        "u_gps_latency_s": (0.0, 2.0), "u_qc_offset_pa": (0.0, 1000.0),
-                       "probe_arm_m": (-50.0, 50.0)}
+                       "probe_arm_m": (-50.0, 50.0), "u_probe_arm_m": (0.0, 50.0),
+                       "u_ps_pa": (0.0, 5000.0)}
+# BudgetInputs field -> the flag's dest, for the flags whose names differ
+_FIELD_FLAG = {"u_rh_pct": "u_rh_percent", "u_qc_scale": "u_qc_scale_percent"}
 
 
-def _budget_inputs(args):
-    from pitotcal.core.checks import number
-    from pitotcal.estimation.identification.budget import inputs_from_options
+def _sensor_options(args):
+    """(BudgetInputs options, their origins) from the aircraft file's [sensors] and the flags
+    (a flag wins); `probe_arm_m` among them is the arm corrected in the data."""
+    from pitotcal.core.checks import choice, number
+    from pitotcal.estimation.identification import sensor_inputs as si
 
-    scale = (None if args.u_qc_scale_percent is None
-             else number("u_qc_scale_percent", args.u_qc_scale_percent, 0.0, 100.0) / 100.0)
+    options, origins = {}, {}
+    if args.aircraft is not None:
+        import tomllib
+
+        from pitotcal.estimation.reporting.aircraft_file import read_aircraft
+        read_aircraft(args.aircraft)            # refuses a bad file, naming the key
+        with open(args.aircraft, "rb") as f:
+            table = tomllib.load(f).get("sensors", {})
+        if isinstance(table, dict):
+            options, origins = si.inputs_from_table(table, args.aircraft)
+    if args.sensor_class is not None:
+        options["sensor_class"] = choice("sensor_class", args.sensor_class, si.SENSOR_CLASSES)
+        origins["sensor_class"] = "flag --sensor-class"
+    if args.oat_source is not None:
+        options["oat_source"] = choice("oat_source", args.oat_source, tuple(si.OAT_SOURCES))
+        origins["oat_source"] = "flag --oat-source"
     if args.u_rh_percent is not None:
         number("u_rh_percent", args.u_rh_percent, 0.0, 100.0)
     for name, (lo, hi) in BUDGET_INPUT_RANGES.items():
         if getattr(args, name) is not None:
             number(name, getattr(args, name), lo, hi)
-    return inputs_from_options(
-        u_oat_k=args.u_oat_k, u_rh_pct=args.u_rh_percent,
-        u_gps_velocity_mps=args.u_gps_velocity_mps, u_gps_latency_s=args.u_gps_latency_s,
-        probe_arm_m=args.probe_arm_m, u_qc_scale=scale,
-        u_qc_offset_pa=args.u_qc_offset_pa)
+    for _, field, _, _ in si.SENSOR_TOML_KEYS:
+        dest = _FIELD_FLAG.get(field, field)
+        value = getattr(args, dest, None)
+        if value is None or field in ("sensor_class", "oat_source"):
+            continue
+        if field == "u_qc_scale":
+            value = number("u_qc_scale_percent", value, 0.0, 100.0) / 100.0
+        options[field] = value
+        origins[field] = f"flag --{dest.replace('_', '-')}"
+    return options, origins
+
+
+def _budget_inputs(args, options=None):
+    """The budget's inputs (`BudgetInputs`, each given value's origin in it), the corrected
+    lever arm left out: identify takes that itself."""
+    from pitotcal.estimation.identification.budget import inputs_from_options
+
+    options, origins = options or _sensor_options(args)
+    given = {k: v for k, v in options.items() if k != "probe_arm_m"}
+    origins = {k: v for k, v in origins.items() if k in given}
+    return inputs_from_options(**given, origins=origins)
 
 
 def run(args):
@@ -203,16 +266,22 @@ def run(args):
     choice("air", args.air, AIR_CHOICES)
     source = Path(args.flight)
     plot_path = _checked_outputs(args, source)
-    inputs = None if args.no_budget else _budget_inputs(args)
+    sensors = _sensor_options(args)
+    inputs = None if args.no_budget else _budget_inputs(args, sensors)
     flight, autopilot, current = _read(args, source)
     result = identify(flight, model=args.model, air=args.air,
-                      gps_noise_std_mps=args.gps_noise_mps, budget=inputs, **_gps_error(args))
+                      gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
+                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
     budget = result.budget
 
     # every file is written before anything is printed, so a reader that goes away early
     # (`| head`) never costs a file
     params, refused = None, None
     if args.params is not None:
+        arm_m = sensors[0].get("probe_arm_m", 0.0)
+        if arm_m:           # the recommendation refits: the data corrected as the result was
+            from pitotcal.estimation.identification.budget import lever_arm_corrected
+            flight = lever_arm_corrected(flight, result, arm_m)
         try:
             params = _write_params(args, flight, autopilot, current)
         except PitotcalError as exc:        # said after the summary
@@ -361,6 +430,9 @@ def _run_live(args):
         raise PitotcalError("give either FLIGHT (a file) or --live CONNECTION, not both")
     choice("model", args.model, list(MODELS))
     positive("target_2sigma_kt", args.target_2sigma_kt)
+    if _sensor_options(args)[0].get("probe_arm_m"):
+        raise PitotcalError("`probe_arm_m`: a live stream is not corrected for the probe's lever "
+                            "arm; identify the flight's log instead")
     plot_path = check_outputs({"--json": args.json, "--plot": args.plot},
                               [(args.live, "the input stream")], figures=["--plot"])["--plot"]
     met = []

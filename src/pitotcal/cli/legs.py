@@ -46,6 +46,10 @@ def add_parser(subparsers):
     p.add_argument("--wind", default="per-band", metavar="MODE",
                    help="global fit: one wind per {band_ft:,.0f} ft pressure-altitude band "
                         "(per-band) or per point (per-point); default %(default)s")
+    p.add_argument("--temp-recovery", type=float, default=None, metavar="R",
+                   help="recovery factor of the probe of a leg file's tat_c / tat_k column "
+                        "(indicated total temperature), T_s = T_t / (1 + R 0.2 M^2); default "
+                        "{temp_recovery:g}")
     g = p.add_argument_group("time-series input (flight CSV or log)")
     g.add_argument("--windows", metavar="T0-T1,...|WINDOWS.csv", default=None,
                    help="the legs' time windows, s ('120-180,200-260'), or a CSV with columns "
@@ -68,7 +72,10 @@ def _help_constants():
     from pitotcal.estimation.legs.flight import DETECT_DEFAULTS, POINT_TOL_KT
     from pitotcal.estimation.legs.global_fit import BAND_FT
 
-    return {**DETECT_DEFAULTS, "point_tol_kt": POINT_TOL_KT, "band_ft": BAND_FT}
+    from pitotcal.io.legs_csv import DEFAULT_TEMP_RECOVERY
+
+    return {**DETECT_DEFAULTS, "point_tol_kt": POINT_TOL_KT, "band_ft": BAND_FT,
+            "temp_recovery": DEFAULT_TEMP_RECOVERY}
 
 
 # A track band wider than a half turn, or a speed band of 50 kt, holds every sample: no leg.
@@ -115,6 +122,9 @@ def run(args):
                   [(source, f"the input {'flight file' if flight else 'leg file'}")],
                   figures=["--plot"])
     if flight:
+        if args.temp_recovery is not None:
+            raise PitotcalError(f"--temp-recovery: only for a leg file's tat_c / tat_k column; "
+                                f"{source} is a flight time series", param="temp_recovery")
         return _run_flight(args, source, data)
     given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out",
                          "--start-s", "--end-s", "--oat-c")
@@ -131,7 +141,10 @@ def _run_legs(args, source, data):
     from pitotcal.io.legs_csv import read_legs
 
     plot_path = _plot_path(args)
-    legs = read_legs(data)
+    from pitotcal.io.legs_csv import DEFAULT_TEMP_RECOVERY
+
+    recovery = DEFAULT_TEMP_RECOVERY if args.temp_recovery is None else args.temp_recovery
+    legs = read_legs(data, temp_recovery=recovery)
     points, fit, notes = analyze_legs(legs, model=args.model, wind=args.wind)
     # files first, then the summary: a reader that goes away early never costs a file
     if args.json is not None:

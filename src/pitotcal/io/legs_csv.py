@@ -11,7 +11,14 @@ One row per constant-speed leg, as flight-test engineers hand-enter them::
 Required: `point` (any label; the legs of one calibration point share it), `ias_kt` (indicated,
 instrument-corrected airspeed V_ic) or `qc_pa` (measured impact pressure q_ci), `pressure_alt_ft`
 (indicated pressure altitude), `oat_c` or `oat_k` (outside static air temperature),
-`groundspeed_kt` and `track_deg` (the leg's GPS ground speed and true track). Optional:
+`groundspeed_kt` and `track_deg` (the leg's GPS ground speed and true track). In place of the
+static OAT, `tat_c` or `tat_k`: the indicated total temperature a probe reads (an aircraft's OAT
+gauge reads the air heated by the ram rise), converted as T_s = T_t / (1 + r 0.2 M²) with the
+probe's recovery factor r (`temp_recovery`, default 1: a total-temperature probe; a bare OAT
+gauge probe is nearer 0.7-0.9) and M the leg's Mach: `oat_k` at the indicated Mach (q_ci at the
+pressure altitude), `LegData.static_oat_k` at the true one, which the solutions use (3 % of
+position error moves the temperature by 0.04 K at 100 KIAS, 3,000 ft, 0.35 K at 250 KIAS,
+10,000 ft). Optional:
 `duration_s` (the leg's length in time) and `groundspeed_sd_kt` (the standard uncertainty of the
 leg's ground velocity, per component, kt). Extra columns are ignored.
 
@@ -33,11 +40,12 @@ from pitotcal.core.units import FT_TO_M, KT_TO_MPS
 from .atomic import atomic_open
 from .read_once import naming, open_binary, read_once
 
-__all__ = ["LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
+__all__ = ["DEFAULT_TEMP_RECOVERY", "LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
 # The columns a leg file needs (either of each pair in `_ALTERNATIVES`).
 LEG_COLUMNS = ("point", "ias_kt", "pressure_alt_ft", "oat_c", "groundspeed_kt", "track_deg")
-_ALTERNATIVES = {"ias_kt": "qc_pa", "oat_c": "oat_k"}
+_ALTERNATIVES = {"ias_kt": ("qc_pa",), "oat_c": ("oat_k", "tat_c", "tat_k")}
+DEFAULT_TEMP_RECOVERY = 1.0
 _OPTIONAL = ("duration_s", "groundspeed_sd_kt")
 # Plausible ranges of the hand-entered numbers (the hint says which unit a value looks like).
 _RANGES = {
@@ -46,6 +54,8 @@ _RANGES = {
     "pressure_alt_ft": (-2000.0, 104987.0, " (the ISA, -2,000 ft to 32 km, 104,987 ft)"),
     "oat_c": (-90.0, 60.0, ""),
     "oat_k": (180.0, 330.0, ""),
+    "tat_c": (-90.0, 100.0, ""),
+    "tat_k": (180.0, 375.0, ""),
     "groundspeed_kt": (1.0, 700.0, ""),
     "track_deg": (0.0, 360.0, ""),
     "duration_s": (0.0, 3600.0, ""),
@@ -71,7 +81,7 @@ class LegData:
     pressure_alt_m : ndarray
         Indicated pressure altitude H_ic, m.
     oat_k : ndarray
-        Outside static air temperature, K.
+        Outside static air temperature, K (from the total temperature when the file gives it).
     groundspeed_mps, track_deg : ndarray
         The leg's GPS ground speed, m/s, and true track, deg.
     duration_s : ndarray
@@ -85,6 +95,14 @@ class LegData:
     sd_from : {"stated", "samples"}
         Where `groundspeed_sd_mps` comes from: the leg file states it, or the legs' own GPS
         samples (`estimation.legs.flight`) estimate it. The bounds are labelled with it.
+    temperature : str
+        Where `oat_k` comes from: "oat_c", "oat_k", or the total-temperature column with its
+        recovery factor ("tat_c, recovery factor 0.8").
+    tat_k : ndarray or None
+        The indicated total temperature, K, when the file gives it (`oat_k` is then its static
+        temperature at the indicated Mach; `static_oat_k` at the true one).
+    temp_recovery : float
+        The probe's recovery factor of `tat_k`.
     """
 
     point: tuple
@@ -99,6 +117,9 @@ class LegData:
     source: str = ""
     lines: tuple = ()
     sd_from: str = "stated"
+    temperature: str = "oat_c"
+    tat_k: np.ndarray | None = None
+    temp_recovery: float = DEFAULT_TEMP_RECOVERY
 
     @property
     def n(self):
@@ -112,6 +133,19 @@ class LegData:
         """Indices of the legs of point `label`."""
         return np.array([i for i, p in enumerate(self.point) if p == label], dtype=int)
 
+    def static_oat_k(self, qc_pa=None, idx=None):
+        """Static OAT of the legs `idx` (all: None), K: `oat_k`; from `tat_k` with the true
+        Mach of impact pressure `qc_pa` when given (the position error in the static source:
+        p_s = p_s,ind + q_ci − q_c), T_s = T_t / (1 + r 0.2 M²)."""
+        from pitotcal.core.moist_air import static_temperature_k
+
+        sel = slice(None) if idx is None else idx
+        if self.tat_k is None or qc_pa is None:
+            return self.oat_k[sel]
+        qci = self.qci_pa[sel]
+        ps = airdata.static_pressure_pa(self.pressure_alt_m[sel]) + qci - qc_pa
+        return static_temperature_k(self.tat_k[sel], qc_pa, ps, self.temp_recovery)
+
     def velocity_ne_mps(self):
         """Ground velocity (north, east), m/s, shape (n, 2)."""
         t = np.radians(self.track_deg)
@@ -122,8 +156,14 @@ class LegData:
         return f"point {self.point[i]} (line {self.lines[i]})" if self.lines else f"point {self.point[i]}"
 
 
-def read_legs(path):
+def read_legs(path, temp_recovery=DEFAULT_TEMP_RECOVERY):
     """Read a leg CSV (module docstring) into a `LegData`.
+
+    Parameters
+    ----------
+    path : str or path-like
+    temp_recovery : float
+        Recovery factor of the probe of a `tat_c` / `tat_k` column, 0-1 (module docstring).
 
     Raises
     ------
@@ -131,6 +171,9 @@ def read_legs(path):
         Unusable file, missing column, bad cell or implausible unit; one line naming file,
         column and row.
     """
+    from pitotcal.core.checks import number
+
+    temp_recovery = number("temp_recovery", temp_recovery, 0.0, 1.0)
     with naming(path):
         path = read_once(path)          # "-", a FIFO or a pipe: read whole once
         name = str(path)
@@ -150,13 +193,20 @@ def read_legs(path):
     else:
         ias_kt = values["ias_kt"]
         qci = airdata.qc_from_cas_pa(ias_kt * KT_TO_MPS)
-    oat_k = values["oat_k"] if "oat_k" in values else values["oat_c"] + 273.15
-    legs = LegData(point=labels, ias_kt=ias_kt, qci_pa=qci,
-                   pressure_alt_m=values["pressure_alt_ft"] * FT_TO_M, oat_k=oat_k,
+    column = next(c for c in ("oat_k", "oat_c", "tat_k", "tat_c") if c in values)
+    kelvin = values[column] + (273.15 if column.endswith("_c") else 0.0)
+    alt_m = values["pressure_alt_ft"] * FT_TO_M
+    temperature, tat_k = column, None
+    if column.startswith("tat"):
+        mach = airdata.mach_from_qc(qci, airdata.static_pressure_pa(alt_m))
+        tat_k, kelvin = kelvin, kelvin / (1.0 + temp_recovery * 0.2 * mach ** 2)
+        temperature = f"{column}, recovery factor {temp_recovery:g}"
+    legs = LegData(point=labels, ias_kt=ias_kt, qci_pa=qci, pressure_alt_m=alt_m, oat_k=kelvin,
                    groundspeed_mps=values["groundspeed_kt"] * KT_TO_MPS,
                    track_deg=values["track_deg"] % 360.0, duration_s=values["duration_s"],
                    groundspeed_sd_mps=values["groundspeed_sd_kt"] * KT_TO_MPS,
-                   source=name, lines=tuple(lines))
+                   source=name, lines=tuple(lines), temperature=temperature, tat_k=tat_k,
+                   temp_recovery=temp_recovery)
     _check_speed_units(legs, values, lines, name)
     _check_track_unit(values["track_deg"], name)
     return legs
@@ -218,13 +268,12 @@ def _choose_columns(header, name):
     """The columns to use: each required one, or its alternative; all missing ones named."""
     use, missing = [], []
     for c in LEG_COLUMNS:
-        alt = _ALTERNATIVES.get(c)
-        if c in header:
-            use.append(c)
-        elif alt and alt in header:
-            use.append(alt)
+        alts = _ALTERNATIVES.get(c, ())
+        found = next((a for a in (c, *alts) if a in header), None)
+        if found:
+            use.append(found)
         else:
-            missing.append(f"{c} (or {alt})" if alt else c)
+            missing.append(f"{c} (or {' or '.join(alts)})" if alts else c)
     if missing:
         raise FlightDataError(f"{name}: missing column {', '.join(missing)}; a leg file has "
                               f"{', '.join(LEG_COLUMNS)}")
@@ -265,6 +314,10 @@ def _unit_hint(col, x):
         return " (looks like kelvin: give degC, or name the column oat_k)"
     if col == "oat_k" and -90.0 <= x <= 60.0:
         return " (looks like degC: give kelvin, or name the column oat_c)"
+    if col == "tat_c" and 180.0 <= x <= 375.0:
+        return " (looks like kelvin: give degC, or name the column tat_k)"
+    if col == "tat_k" and -90.0 <= x <= 100.0:
+        return " (looks like degC: give kelvin, or name the column tat_c)"
     return ""
 
 

@@ -22,8 +22,8 @@ def fitted():
 
 
 INPUTS = bd.BudgetInputs(u_oat_k=1.0, u_rh_pct=30.0, u_gps_velocity_mps=0.1,
-                         u_gps_latency_s=0.1, probe_arm_m=1.0, u_qc_scale=0.002,
-                         u_qc_offset_pa=2.0)
+                         u_gps_latency_s=0.1, u_probe_arm_m=1.0, u_qc_scale=0.002,
+                         u_qc_offset_pa=2.0, u_ps_pa=200.0)
 
 
 @pytest.fixture(scope="module")
@@ -86,13 +86,15 @@ def test_combination_and_list(budget):
 
 def test_defaults_and_refusals(fitted):
     flight, result = fitted
-    assert bd.BudgetInputs().u_oat_k == 1.0
+    # the default u(OAT) is the flight-test class's probe value for a flight with an oat_k
+    resolved, _ = bd.resolve(bd.BudgetInputs(), flight)
+    assert resolved.u_oat_k == 1.0 and resolved.oat_source == "probe"
     with pytest.raises(PitotcalError, match="u_oat_k"):
         bd.inputs_from_options(u_oat_k=-1.0)
     with pytest.raises(PitotcalError, match="unknown budget input"):
         bd.inputs_from_options(u_oat=1.0)
     zero = bd.BudgetInputs(u_oat_k=0, u_rh_pct=0, u_gps_velocity_mps=0, u_gps_latency_s=0,
-                           u_qc_scale=0, u_qc_offset_pa=0)
+                           u_qc_scale=0, u_qc_offset_pa=0, u_ps_pa=0)
     b = bd.uncertainty_budget(flight, result, zero)
     assert b.expanded_kt == pytest.approx(2 * b.statistical_kt)
 

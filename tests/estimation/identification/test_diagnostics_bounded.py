@@ -36,7 +36,12 @@ def test_turbulent_clean_flight_seed_2_is_not_refused(turbulence_mps):
     assert result.success
     _truth_within(result, truth)
     assert np.isfinite(result.consistency["undetected"]["dv_shift_kt"])
-    assert result.to_dict()["consistency"]["undetected"]["first_order_vi_kt"] == []
+    # at 3 m/s the step caught at 95 % power is larger than q_ci itself (1.16 since the scan
+    # has 54 alternatives, bound 3.74; 1.09 at 3.36 before), so at some of the table's speeds
+    # the shifted calibration has no V_c and its shift is stated to first order
+    rows = [row["vi_kt"] for row in result.correction_table()]
+    first_order = result.to_dict()["consistency"]["undetected"]["first_order_vi_kt"]
+    assert set(first_order) <= set(rows)
 
 
 def test_lean_monte_carlo_turbulent_clean_flights_none_refused():

@@ -190,3 +190,105 @@ def test_zero_groundspeed_sd_is_no_statement_of_accuracy():
     gs, tk = [178.0, 185.0, 188.0, 181.0], [178.0, 82.0, 355.0, 265.0]
     sol, _ = solve_point(_legs(gs, tk, sd_kt=0.0), "1")
     assert sol.bound == "scatter" and np.isfinite(sol.tas_half_mps)
+
+
+# --- legs flown at different indicated airspeeds: each leg's own TAS ------------------------
+
+def _constructed_point(ias_kt, tracks_deg, wind_kt=15.0, wind_from=250.0, ratio=0.03,
+                       alt_ft=(5000.0,), oat_k=(278.15,)):
+    """Legs of known truth: each flies the TAS of its own IAS, altitude and OAT with the
+    pressure error Δp = ratio q_ci in the static source; (LegData, wind N/E m/s, true ΔV kt
+    at the point's mean q_ci)."""
+    from pitotcal.core import airdata
+    from pitotcal.estimation.legs.points import cas_from_tas_mps
+
+    n = len(ias_kt)
+    ias = np.asarray(ias_kt, float)
+    alt_m = np.broadcast_to(np.asarray(alt_ft, float) * 0.3048, (n,)).copy()
+    oat = np.broadcast_to(np.asarray(oat_k, float), (n,)).copy()
+    qci = airdata.qc_from_cas_pa(ias * KT_TO_MPS)
+    ps = airdata.static_pressure_pa(alt_m) - qci * ratio
+    tas = airdata.mach_from_qc(qci * (1 + ratio), ps) * airdata.speed_of_sound_mps(oat)
+    w = np.array(wind_polar_inverse(wind_kt * KT_TO_MPS, wind_from))
+    t = np.radians(tracks_deg)                           # headings: the air vector's direction
+    g = np.column_stack([tas * np.cos(t), tas * np.sin(t)]) + w
+    legs = LegData(point=("1",) * n, ias_kt=ias, qci_pa=qci, pressure_alt_m=alt_m, oat_k=oat,
+                   groundspeed_mps=np.hypot(*g.T),
+                   track_deg=np.degrees(np.arctan2(g[:, 1], g[:, 0])) % 360.0,
+                   duration_s=np.full(n, np.nan), groundspeed_sd_mps=np.full(n, np.nan),
+                   source="constructed.csv", lines=tuple(range(2, n + 2)))
+    qci_ref = float(np.mean(qci))
+    vc = airdata.cas_from_qc_mps(qci_ref * (1 + ratio))
+    dv_true = (vc - airdata.cas_from_qc_mps(qci_ref)) / KT_TO_MPS
+    assert cas_from_tas_mps(1.0, qci_ref, 1e5, 288.0)[0] > 0       # the helper exists
+    return legs, w, float(dv_true)
+
+
+def wind_polar_inverse(speed, frm):
+    a = np.radians(frm)
+    return -speed * np.cos(a), -speed * np.sin(a)
+
+
+@pytest.mark.parametrize("ias_kt, tracks", [
+    ([100.0, 102.0, 101.0], [10.0, 130.0, 250.0]),                    # 3 legs, 2 kt apart
+    ([120.0, 118.0, 119.5, 121.0], [0.0, 90.0, 180.0, 270.0]),        # Horton's 4 legs
+])
+def test_legs_at_differing_ias_recover_a_constructed_wind(ias_kt, tracks):
+    """A point whose legs' IAS differ by up to 2 kt: the per-leg TAS solution recovers the
+    constructed wind to 0.05 kt and 0.5° and ΔV to 0.01 kt; one TAS for all legs (the
+    classic assumption) misses the wind by about a knot."""
+    legs, w, dv_true = _constructed_point(ias_kt, tracks)
+    sol, notes = solve_point(legs, "1")
+    speed, frm = sol.wind
+    true_speed, true_from = wind_polar(*w)
+    assert abs(speed - float(true_speed)) / KT_TO_MPS < 0.05
+    assert abs((frm - float(true_from) + 180) % 360 - 180) < 0.5
+    assert sol.dv_kt == pytest.approx(dv_true, abs=0.01)
+    assert np.max(np.abs(sol.residuals_mps)) < 1e-6
+    one = three_leg(legs.velocity_ne_mps()[:3])                      # the one-TAS answer
+    assert np.hypot(one[0] - w[0], one[1] - w[1]) / KT_TO_MPS > 0.5
+    assert not any("assumes one airspeed" in n for n in notes)
+
+
+def test_legs_at_differing_altitude_and_oat():
+    """Each leg's own altitude and OAT too (±300 ft, ±2 K): wind and ΔV recovered."""
+    legs, w, dv_true = _constructed_point([150.0, 151.0, 149.0, 150.5], [20, 110, 200, 290],
+                                          alt_ft=(5000.0, 5300.0, 4700.0, 5100.0),
+                                          oat_k=(278.0, 276.0, 280.0, 277.5), ratio=-0.02)
+    sol, _ = solve_point(legs, "1")
+    assert np.hypot(sol.wind_n_mps - w[0], sol.wind_e_mps - w[1]) / KT_TO_MPS < 0.05
+    assert sol.dv_kt == pytest.approx(dv_true, abs=0.02)
+
+
+def test_same_ias_is_the_one_radius_circle():
+    """Legs sharing q_ci, altitude and OAT: δ = 0 and the closed form, unchanged."""
+    legs = _legs([178, 185, 188], [178, 82, 355])
+    sol, _ = solve_point(legs, "1")
+    np.testing.assert_array_equal(sol.tas_offsets_mps, 0.0)
+    x = three_leg(_g([178, 185, 188], [178, 82, 355]) * KT_TO_MPS)
+    assert (sol.wind_n_mps, sol.wind_e_mps, sol.tas_mps) == pytest.approx(tuple(x), abs=1e-9)
+
+
+@pytest.mark.parametrize("ias_kt", [[250.0, 250.0, 250.0, 250.0], [249.0, 251.0, 250.0, 250.5]])
+def test_total_temperature_converted_with_the_true_mach(ias_kt):
+    """A leg file giving the indicated total temperature (r = 0.8) at 250 KIAS, 10,000 ft with
+    3 % of position error: each leg's static OAT from its true Mach recovers the constructed
+    wind and ΔV; the indicated Mach (0.35 K too warm) would move ΔV by ~0.1 kt."""
+    import dataclasses
+
+    from pitotcal.core import airdata
+
+    legs, w, dv_true = _constructed_point(ias_kt, [0.0, 90.0, 180.0, 270.0], ratio=0.03,
+                                          alt_ft=(10000.0,), oat_k=(268.0,))
+    ps_ind = airdata.static_pressure_pa(legs.pressure_alt_m)
+    m_true = airdata.mach_from_qc(legs.qci_pa * 1.03, ps_ind - 0.03 * legs.qci_pa)
+    m_ind = airdata.mach_from_qc(legs.qci_pa, ps_ind)
+    tat = 268.0 * (1 + 0.8 * 0.2 * m_true ** 2)
+    total = dataclasses.replace(legs, tat_k=tat, temp_recovery=0.8,
+                                oat_k=tat / (1 + 0.8 * 0.2 * m_ind ** 2))
+    sol, _ = solve_point(total, "1")
+    assert np.hypot(sol.wind_n_mps - w[0], sol.wind_e_mps - w[1]) / KT_TO_MPS < 0.01
+    assert sol.dv_kt == pytest.approx(dv_true, abs=0.005)
+    assert sol.oat_k == pytest.approx(268.0, abs=0.005)
+    indicated, _ = solve_point(dataclasses.replace(total, tat_k=None), "1")
+    assert indicated.oat_k - 268.0 > 0.25 and abs(indicated.dv_kt - dv_true) > 0.05

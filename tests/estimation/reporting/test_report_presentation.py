@@ -67,6 +67,14 @@ def test_budget_in_words_with_a_speed_column(fitted):
     for snake in ("gps_velocity_bias", "qc_scale", "probe_lever_arm"):
         assert snake not in html
     assert "Outside air temperature" in html and "0.1 % of reading" in html
+    # where each input came from, and the settings behind the defaults, in words
+    table = html.split('id="budget-table"')[1].split("</table>")[0]
+    assert "<th>Input from</th>" in table and "default of class flight-test" in table
+    assert "Static-pressure transducer" in table
+    settings = html.split('id="budget-settings"')[1].split("</p>")[0]
+    assert "Sensor class: flight-test (default)" in settings
+    assert "Temperature source: probe (the flight: oat_k)" in settings
+    assert "Probe lever arm corrected in the data: 0 m (none corrected)" in settings
     table = html.split('id="budget-speed-table"')[1].split("</table>")[0]
     body = re.findall(r"<tr><td class=\"num\">([\d.]+)</td>", table)
     assert [float(v) for v in body] == [r["vi_kt"] for r in result["airspeed_correction"]]
