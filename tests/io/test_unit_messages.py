@@ -136,3 +136,19 @@ def test_a_1200_hz_log_in_seconds_is_read(tmp_path):
     flight, _ = pitotcal.simulate(pitotcal.plan_maneuver(), seed=1, rate_hz=1200.0)
     path = pitotcal.write_flight_csv(flight, tmp_path / "fast.csv")
     assert pitotcal.read_flight(path).n == flight.n
+
+
+@pytest.mark.parametrize("rate_hz", [1.0, 5.0, 10.0, 16.0])
+def test_minutes_in_level_flight_without_a_climb_are_told_by_the_acceleration(demo_columns,
+                                                                              tmp_path, rate_hz):
+    """Level flight, no alt_m or gps_vd_mps, 1-16 Hz: in minutes the step (1-17 ms) is a
+    plausible step in seconds, and only the GPS velocity's change rate (a turn at 6-7 g)
+    tells; the same flight in seconds is read."""
+    every = int(round(50.0 / rate_hz))
+    cols = {k: v[::every].copy() for k, v in demo_columns.items()
+            if k not in ("alt_m", "gps_vd_mps")}
+    assert read_flight(_write(dict(cols), tmp_path / "seconds.csv")).n == cols["time_s"].size
+    cols["time_s"] = cols["time_s"] / 60.0
+    with pytest.raises(FlightDataError, match=r"column time_s looks like minutes: with it in "
+                                              r"seconds the GPS velocity .* changes at "):
+        read_flight(_write(cols, tmp_path / "minutes.csv"))

@@ -101,12 +101,14 @@ def flag_message(parser, args, exc):
     flags = {a.dest: max(a.option_strings, key=len) for a in command._actions if a.option_strings}
     message = _WINDOW.sub(lambda m: (flags[m[1]] + (" " if m[2] else "")) if m[1] in flags
                           else m[0], message)
+    # the backquoted names first: `columns` becomes --columns, never `--columns`
+    message = _ARGUMENT.sub(lambda m: flags.get(_FLAG_DEST.get(m[1], m[1]), m[0]), message)
     names = [getattr(exc, "param", None), *getattr(exc, "mentions", ())]
     for name in filter(None, names):
         flag = flags.get(_FLAG_DEST.get(name, name))
         if flag:            # the parameter as a word of its own, not part of a file name
             message = re.sub(rf"(?<![\w/.\\-]){re.escape(name)}(?![\w/.\\-])", flag, message)
-    return _ARGUMENT.sub(lambda m: flags.get(_FLAG_DEST.get(m[1], m[1]), m[0]), message)
+    return message
 
 
 def _warning_printer(parser, args):

@@ -96,6 +96,9 @@ def check_outputs(outputs, inputs=(), *, figures=()):
     path; then the figure formats.
     """
     figures = set(figures)
+    for flag, path in outputs.items():
+        if path is not None:            # as given, before a figure's ".png" is added
+            _check_given(flag, Path(path))
     written = {flag: None if path is None else _as_written(path, flag in figures)
                for flag, path in outputs.items()}
     for flag, out in written.items():
@@ -118,14 +121,25 @@ def _as_written(path, figure):
     return f"{path}.png" if figure and not Path(path).suffix else path
 
 
-def _check_one(flag, out, inputs):
+def _check_given(flag, out):
     from pitotcal.core.errors import PitotcalError
+    from pitotcal.io.atomic import special_file
 
     if str(out) == "-":                 # stdout carries the summary: no JSON mixed into it
         raise PitotcalError(f"{flag} -: an output here is a file, not stdout (which carries "
                             "the summary): give a file name")
     if out.is_dir():
         raise PitotcalError(f"{flag} {out} is a folder: give the file to write")
+    kind = special_file(out)
+    if kind:        # renaming a file onto it would replace the FIFO or device itself
+        raise PitotcalError(f"{flag} {out} is {kind}, not a file: every output is written "
+                            "whole to a regular file; give a file name")
+
+
+def _check_one(flag, out, inputs):
+    from pitotcal.core.errors import PitotcalError
+
+    _check_given(flag, out)
     for source, what in inputs:
         if source is not None and (out.resolve() == Path(source).resolve()
                                    or _same_file(out, source)):

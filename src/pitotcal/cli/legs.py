@@ -82,10 +82,12 @@ def _help_constants():
 DETECT_MAX = {"track_tol_deg": 180.0, "groundspeed_tol_kt": 50.0, "ias_tol_kt": 50.0}
 
 
-def _is_flight(path):
+def _is_flight(path, data):
     from pitotcal.io.flight_csv import csv_kind
+    from pitotcal.io.read_once import log_suffix
 
-    return path.suffix.lower() in LOG_SUFFIXES or csv_kind(path) in ("flight", "plan")
+    return (path.suffix.lower() in LOG_SUFFIXES or log_suffix(data) is not None
+            or csv_kind(data) in ("flight", "plan"))
 
 
 def _series_options(args):
@@ -109,12 +111,13 @@ def run(args):
 
     choice("model", args.model, list(MODELS))
     choice("wind", args.wind, WIND_CHOICES)
-    from pitotcal.io.read_once import is_stream
+    from pitotcal.io.read_once import is_stream, read_once
 
     source = Path(args.legs)
     if not source.is_file() and not is_stream(source):
         raise PitotcalError(f"{source}: no such file", param="legs")
-    flight = _is_flight(source)
+    data = read_once(source)        # a stream is read here once; each reader gets its bytes
+    flight = _is_flight(source, data)
     check_outputs({"--json": args.json, "--plot": args.plot, "--legs-out": args.legs_out},
                   [(source, f"the input {'flight file' if flight else 'leg file'}")],
                   figures=["--plot"])
@@ -122,17 +125,17 @@ def run(args):
         if args.temp_recovery is not None:
             raise PitotcalError(f"--temp-recovery: only for a leg file's tat_c / tat_k column; "
                                 f"{source} is a flight time series", param="temp_recovery")
-        return _run_flight(args, source)
+        return _run_flight(args, source, data)
     given = [f for f in ("--windows", *DETECT_FLAGS, "--point-tol-kt", "--legs-out",
                          "--start-s", "--end-s", "--oat-c")
              if getattr(args, f[2:].replace("-", "_")) is not None]
     if given:
         raise PitotcalError(f"{given[0]}: only for a flight time series; {source} is a leg "
                             f"file", param=given[0])
-    return _run_legs(args, source)
+    return _run_legs(args, source, data)
 
 
-def _run_legs(args, source):
+def _run_legs(args, source, data):
     from pitotcal.estimation.legs.report import analyze_legs, legs_json, legs_summary, plot_legs
     from pitotcal.io.jsonfile import write_json
     from pitotcal.io.legs_csv import read_legs
@@ -141,7 +144,7 @@ def _run_legs(args, source):
     from pitotcal.io.legs_csv import DEFAULT_TEMP_RECOVERY
 
     recovery = DEFAULT_TEMP_RECOVERY if args.temp_recovery is None else args.temp_recovery
-    legs = read_legs(source, temp_recovery=recovery)
+    legs = read_legs(data, temp_recovery=recovery)
     points, fit, notes = analyze_legs(legs, model=args.model, wind=args.wind)
     # files first, then the summary: a reader that goes away early never costs a file
     if args.json is not None:
@@ -163,13 +166,16 @@ def _windows(text):
     if text is None:
         return None
     if Path(text).is_file():
-        return read_windows(text)
+        from pitotcal.io.read_once import naming
+
+        with naming(text):
+            return read_windows(text)
     if text.lower().endswith(".csv"):
         raise PitotcalError(f"--windows {text}: no such file", param="windows")
     return parse_windows(text)
 
 
-def _run_flight(args, source):
+def _run_flight(args, source, data):
     from .common import oat_k_from_c
     from pitotcal.core.checks import number
     from pitotcal.core.errors import PitotcalError
@@ -189,7 +195,7 @@ def _run_flight(args, source):
     tol = 3.0 if args.point_tol_kt is None else number("--point-tol-kt", args.point_tol_kt,
                                                         0.0, 50.0, lo_open=True)
     windows = _windows(args.windows)
-    flight = read_flight(source, start_s=args.start_s, end_s=args.end_s,
+    flight = read_flight(data, start_s=args.start_s, end_s=args.end_s,
                          oat_k=oat_k_from_c(args.oat_c))
     span_s = float(flight.time_s[-1] - flight.time_s[0])
     for key in ("min_leg_s", "smooth_s"):          # a window longer than the data holds nothing

@@ -170,6 +170,7 @@ def _geo_settings(args):
     except PitotcalError as exc:
         name = "--magvar-deg" if exc.param == "magvar_deg" else "--center"
         raise PitotcalError(f"{name}: {exc}") from None
+    _check_clear_of_the_poles(lat, lon)
     if args.export:
         from pathlib import Path
 
@@ -213,6 +214,36 @@ def _add_design_arguments(p):
                         "(default: {check_fraction:g}; 0: two speeds only)")
 
 
+def _check_clear_of_the_poles(lat, lon):
+    """Refuse a centre whose test area (a loiter up to the largest radius a plan may have)
+    could reach a pole: there north and east have no meaning (a card centred at 90 deg N would
+    start beyond it)."""
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.maneuvers.plan.request import MAX_RADIUS_M
+
+    limit = 90.0 - MAX_RADIUS_M / 111_000.0            # 111 km per degree of latitude
+    if abs(lat) > limit:
+        raise PitotcalError(f"--center {lat:g} {lon:g}: a loiter of up to {MAX_RADIUS_M / 1e3:g} "
+                            f"km there could cross the pole, where the card's north and east "
+                            f"have no meaning; centre the test area within {limit:.1f} deg of "
+                            "the equator")
+
+
+def _check_duration_holds_steps(args):
+    """--duration-s shorter than two --dt-s steps, named as the duration (the library's
+    rule is on the step: a default --dt-s the user did not give)."""
+    import math
+
+    from pitotcal.core.errors import PitotcalError
+
+    d, dt = args.duration_s, args.dt_s
+    if d is not None and dt is not None and math.isfinite(d) and math.isfinite(dt) \
+            and 0.0 < dt and 0.0 < d < 2.0 * dt:
+        raise PitotcalError(f"--duration-s {d:g} holds fewer than two time steps of --dt-s "
+                            f"{dt:g}: give at least {2.0 * dt:g} s (a calibration maneuver is "
+                            "minutes long)")
+
+
 def _request(args, max_iter):
     """The flags as the library's `PlanRequest`: it checks each value, naming the field, which
     `pitotcal.cli.flag_message` shows as its flag (a design flag without --design optimal
@@ -230,6 +261,7 @@ def _request(args, max_iter):
             shown = flag if value is True else f"{flag} {value}"
             raise PitotcalError(f"{shown} is for --design paper: --design optimal chooses its "
                                 f"own speed schedule")
+    _check_duration_holds_steps(args)
     given = {name: getattr(args, name) for name in _DESIGN_FIELDS
              if getattr(args, name) is not None}
     # --profile and --levels when given, else the library's defaults

@@ -145,9 +145,29 @@ def _outputs(args):
     return out, truth_out
 
 
+# The simulator's options a plan's comment lines supply when their flag is not given.
+_FROM_PLAN = ("wind_speed_mps", "wind_from_deg")
+
+
+def _plan_comment_error(exc, args, plan):
+    """`exc` about a value the plan's comment line gave (its wind, no flag given) as an error
+    naming that line, not the flag the user did not give; else `exc` itself."""
+    from pitotcal.core.errors import PitotcalError
+
+    param = getattr(exc, "param", None)
+    if param not in _FROM_PLAN or getattr(args, param) is not None \
+            or param not in plan.settings:
+        return exc
+    rule = str(exc).removeprefix(param).strip()
+    flag = "--" + param.replace("_", "-")
+    return PitotcalError(f"{args.plan}: comment line '# {param}: {plan.settings[param]}': "
+                         f"{rule} (the plan's wind, flown when {flag} is not given)")
+
+
 def run(args):
     import warnings
 
+    from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import get_model
     from pitotcal.io import write_flight_csv
     from pitotcal.io.plan_csv import read_plan
@@ -161,7 +181,10 @@ def run(args):
         from pitotcal.maneuvers.fly.faults import parse_fault
         fault = parse_fault(args.fault, seed=args.seed)
     plan = read_plan(args.plan)
-    flight, truth = simulate(plan, options, seed=args.seed)
+    try:
+        flight, truth = simulate(plan, options, seed=args.seed)
+    except PitotcalError as exc:
+        raise _plan_comment_error(exc, args, plan) from None
     if fault is not None:
         from pitotcal.maneuvers.fly.faults import apply_fault
         flight = apply_fault(flight, truth, fault)

@@ -16,6 +16,7 @@ from pitotcal.core.moist_air import check_air_options, with_static_air
 from .flight_checks import check_window
 from .flight_csv import read_flight_csv, write_flight_csv
 from .plan_csv import read_plan, write_plan
+from .read_once import log_suffix, naming, read_once
 from .result_record import read_result
 from .streams import LOG_EXTENSIONS
 
@@ -46,7 +47,8 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
     ----------
     path : str or path-like
         A flight CSV (docs/interfaces.md §1) or a log: `.ulg` (PX4 ULog), `.bin`/`.log` (ArduPilot
-        DataFlash), read by `pitotcal.io.logs.read_log`.
+        DataFlash), read by `pitotcal.io.logs.read_log`; ``-`` (standard input) or a FIFO is
+        read once, whole (`pitotcal.io.read_once`), a log on it known by its first bytes.
     start_s, end_s : float, optional
         Keep only samples with start_s <= time_s <= end_s, s (e.g. cut off taxi and take-off).
         Validation (the 1 % bad-row rule) applies inside this window only.
@@ -98,7 +100,15 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
         return with_reading(read_mapped_csv(path, columns, start_s, end_s,
                                             temp_recovery=temp_recovery, rh_pct=rh_pct),
                             {**reading, "columns": str(columns)})
-    if is_log_file(path):
+    with naming(path):
+        return _read_flight(read_once(path), reading)
+
+
+def _read_flight(path, reading):
+    """`read_flight` of `path` (a file, or a stream's bytes read once) with `reading` checked."""
+    start_s, end_s, oat_k = reading["start_s"], reading["end_s"], reading["oat_k"]
+    temp_recovery, rh_pct = reading["temp_recovery"], reading["rh_pct"]
+    if is_log_file(path) or log_suffix(path):       # a log by its name, or on a stream by its bytes
         from .logs import read_log
         flight = read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k)
         return with_reading(with_static_air(flight, temp_recovery=temp_recovery,

@@ -7,10 +7,26 @@ splice of both (`os.replace` is atomic on one filesystem).
 
 import contextlib
 import os
+import stat
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_open", "atomic_path", "save_figure"]
+from pitotcal.core.errors import PitotcalError
+
+__all__ = ["atomic_open", "atomic_path", "save_figure", "special_file"]
+
+_SPECIAL = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a device"), (stat.S_ISBLK, "a device"),
+            (stat.S_ISSOCK, "a socket"))
+
+
+def special_file(path):
+    """"a FIFO", "a device" or "a socket" when `path` exists as one (a symlink followed),
+    else None (a regular file, a folder or nothing)."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None
+    return next((what for test, what in _SPECIAL if test(mode)), None)
 
 
 @contextlib.contextmanager
@@ -19,8 +35,18 @@ def atomic_path(path):
 
     On an exception the temporary file is removed and `path` is untouched. The new file gets
     the permissions a plain ``open(path, "w")`` would give it (umask applied).
+
+    Raises
+    ------
+    PitotcalError
+        `path` is a FIFO, a device or a socket (``/dev/null`` included): a rename would
+        replace it, and a stream cannot be written whole or not at all.
     """
     path = Path(path)
+    kind = special_file(path)
+    if kind:            # os.replace would put a regular file in place of /dev/null or a FIFO
+        raise PitotcalError(f"{path} is {kind}, not a file: pitotcal writes its outputs whole "
+                            "to regular files")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
     os.close(fd)
     try:

@@ -12,9 +12,11 @@ import numpy as np
 from pitotcal.core import checks
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.measurement import impact_pressure_pa, tas_squared
-from pitotcal.core.units import R_AIR_JKGK, isa_altitude_m, isa_pressure_pa, isa_temperature_k
+from pitotcal.core.units import (G0_MPS2, R_AIR_JKGK, isa_altitude_m, isa_pressure_pa,
+                                 isa_temperature_k)
 
-__all__ = ["MAX_BAD_FRACTION", "PLAUSIBLE", "QCI_MIN_FLYING_PA", "check_plausible", "check_time_units",
+__all__ = ["MAX_BAD_FRACTION", "PLAUSIBLE", "QCI_MIN_FLYING_PA", "check_plausible",
+           "check_time_by_acceleration", "check_time_units",
            "check_units", "check_vertical_speed", "check_window", "drop_bad_rows", "looks_utf16"]
 
 MAX_BAD_FRACTION = 0.01      # more unusable rows than this is a bad column, not a glitch
@@ -204,7 +206,10 @@ def check_rho(name, rho):
     med = float(np.median(rho))
     if 0.15 <= med <= 1.6:
         return
-    unit = " (looks like g/m^3)" if 150 <= med <= 1600 else ""
+    # the density in another unit: g/m^3, lb/ft^3 (1 lb/ft^3 = 16.0185 kg/m^3), slug/ft^3
+    units = (("g/m^3", 1e-3), ("lb/ft^3", 16.0185), ("slug/ft^3", 515.379))
+    unit = next((f" (looks like {u}: x {k:g} to kg/m^3)" for u, k in units
+                 if 0.15 <= med * k <= 1.6), "")
     raise FlightDataError(f"{name}: column rho_kgm3: median {med:.4g} is not an air density in "
                           f"kg/m^3 (0.15-1.6){unit}")
 
@@ -358,6 +363,44 @@ def check_time_units(name, t):
         warnings.warn(text, stacklevel=3)
         return text
     return None
+
+
+# A calibration flight's horizontal acceleration (GPS velocity change over about a second):
+# a 45 deg banked turn pulls 1 g; sustained over a tenth of the record, more than 3 g is no
+# calibration flight in seconds, while a clock in minutes makes an ordinary turn 60 times that.
+_ACCEL_MAX_MPS2 = 3.0 * G0_MPS2
+_ACCEL_QUANTILE = 90.0
+
+
+def check_time_by_acceleration(name, t, vn, ve):
+    """Refuse a time column in minutes that the step rule cannot tell (a log at 1-16 Hz
+    steps 1-17 ms in minutes, as a 60-1000 Hz log in seconds does), by what the clock makes of
+    the GPS velocity: the velocity change over a window of one time unit (a quarter of the
+    record when shorter), divided by it, is in a tenth of the record above 3 g, where a 60th
+    of it would fly.
+
+    Notes
+    -----
+    Independent of `alt_m` and `gps_vd_mps` (a level flight has neither signal) and of the
+    GPS noise (a 0.1 m/s velocity noise differenced over 1 s is 0.14 m/s^2).
+    """
+    span = float(t[-1] - t[0])
+    # in minutes a log of 1 Hz or more steps 1/60 or less: slower ones are no calibration log
+    if t.size < 10 or not span > 0.0 or not float(np.median(np.diff(t))) <= 1.001 / 60.0:
+        return
+    window = min(1.0, span / 4.0)
+    later = t[t <= t[-1] - window]
+    if later.size < 5:
+        return
+    dv = np.hypot(np.interp(later + window, t, vn) - np.interp(later, t, vn),
+                  np.interp(later + window, t, ve) - np.interp(later, t, ve))
+    accel = float(np.percentile(dv / window, _ACCEL_QUANTILE))
+    if accel > _ACCEL_MAX_MPS2 and accel / 60.0 <= _ACCEL_MAX_MPS2:
+        raise FlightDataError(
+            f"{name}: column time_s looks like minutes: with it in seconds the GPS velocity "
+            f"(gps_vn_mps, gps_ve_mps) changes at {accel / G0_MPS2:.3g} g in a tenth of the "
+            f"record ({accel / 60.0 / G0_MPS2:.2g} g in minutes); expected seconds "
+            "(time_s = value x 60)")
 
 
 # A calibration is flown near level: the median |vertical speed| of a flight is a few percent

@@ -60,12 +60,13 @@ from pitotcal.core.plan import PLAN_COLUMNS
 from pitotcal.core.units import ISA_T0_K, density_kgm3
 
 from .atomic import atomic_open
-from .read_once import open_binary, read_once
+from .read_once import naming, open_binary, read_once
 from .flight_checks import (
     check_plausible,
     check_ps_oat,
     check_rho,
     check_time,
+    check_time_by_acceleration,
     check_time_units,
     check_units,
     check_vertical_speed,
@@ -166,6 +167,7 @@ def read_flight_csv(path, start_s=None, end_s=None, *, temp_recovery=1.0, rh_pct
     if "gps_vd_mps" in col:
         check_vertical_speed(name, data[:, col["gps_vd_mps"]], vn, ve, time_s,
                              data[:, col["alt_m"]] if "alt_m" in col else None)
+    check_time_by_acceleration(name, time_s, vn, ve)     # level flight: no climb to tell
     if "ps_ref_pa" in col:
         check_ps_oat(name, data[:, col["ps_ref_pa"]], np.full(1, ISA_T0_K), column="ps_ref_pa",
                      alt=alt)
@@ -184,7 +186,11 @@ def csv_kind(path):
 
     Looks only at the header (after any ``#`` lines); never raises for a file it can open.
     """
-    path = read_once(path)
+    with naming(path):
+        return _csv_kind(read_once(path))
+
+
+def _csv_kind(path):
     name = str(path)
     try:
         _reject_binary(path, name)

@@ -38,7 +38,7 @@ from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
 from .atomic import atomic_open
-from .read_once import open_binary, read_once
+from .read_once import naming, open_binary, read_once
 
 __all__ = ["DEFAULT_TEMP_RECOVERY", "LEG_COLUMNS", "LegData", "read_legs", "write_legs"]
 
@@ -174,9 +174,10 @@ def read_legs(path, temp_recovery=DEFAULT_TEMP_RECOVERY):
     from pitotcal.core.checks import number
 
     temp_recovery = number("temp_recovery", temp_recovery, 0.0, 1.0)
-    path = read_once(path)          # "-", a FIFO or a pipe: read whole once
-    name = str(path)
-    header, rows, lines = _read_rows(path, name)
+    with naming(path):
+        path = read_once(path)          # "-", a FIFO or a pipe: read whole once
+        name = str(path)
+        header, rows, lines = _read_rows(path, name)
     cols = _choose_columns(header, name)
     values = {c: _column(c, header, rows, lines, name) for c in cols if c != "point"}
     for c in _OPTIONAL:
@@ -207,6 +208,7 @@ def read_legs(path, temp_recovery=DEFAULT_TEMP_RECOVERY):
                    source=name, lines=tuple(lines), temperature=temperature, tat_k=tat_k,
                    temp_recovery=temp_recovery)
     _check_speed_units(legs, values, lines, name)
+    _check_track_unit(values["track_deg"], name)
     return legs
 
 
@@ -317,6 +319,17 @@ def _unit_hint(col, x):
     if col == "tat_k" and -90.0 <= x <= 100.0:
         return " (looks like degC: give kelvin, or name the column tat_c)"
     return ""
+
+
+def _check_track_unit(track, name):
+    """Refuse tracks in radians: spread over more than 1 yet all within 0-2 pi, they are legs
+    flown within 6.3 deg of one another in degrees, which no leg method can use."""
+    if track.size >= 3 and np.ptp(track) >= 1.0 and track.min() >= 0.0 \
+            and track.max() <= 2.0 * np.pi:
+        raise FlightDataError(
+            f"{name}: column track_deg: every track lies within {track.min():.3g}-"
+            f"{track.max():.3g}, as radians would (x 57.2958 to degrees); legs within 6.3 "
+            "degrees of one another cannot separate the wind")
 
 
 def _check_speed_units(legs, values, lines, name):

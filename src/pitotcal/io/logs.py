@@ -72,6 +72,7 @@ from .airborne import airspeed_gate, flight_state_cuts
 from .flight_checks import QCI_MIN_FLYING_PA, check_window, implausible_samples, window_text
 from .flight_csv import PLAN_NOT_FLIGHT, csv_kind
 from .flightlog import AutopilotWind, FlightLog
+from .read_once import log_file, naming
 from .streams import LOG_EXTENSIONS
 from .timebase import apply_cuts, clean, gps_onto, spans
 
@@ -128,7 +129,8 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     Parameters
     ----------
     path : str or Path
-        ``.ulg``, ``.bin`` or ``.log``.
+        ``.ulg``, ``.bin`` or ``.log``; or ``-`` (standard input), a FIFO or a pipe, read once
+        (a log there is known by its name's extension or its first bytes).
     start_s, end_s : float, optional
         Window, seconds since log start.
     gps_resample : {"linear", "hold"}
@@ -150,12 +152,12 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     -------
     FlightLog
     """
-    path = Path(path)
     options = _check_options(gps_resample, gps_latency_s, min_groundspeed_mps, min_qci_pa, oat_k,
                              min_airspeed_mps)
     start_s, end_s = check_window(start_s, end_s)
-    streams = _read_streams(path)
-    return _assemble(streams, path.name, start_s, end_s, options)
+    with naming(path), log_file(path, LOG_EXTENSIONS) as file:   # "-" or a FIFO: read once
+        streams = _read_streams(Path(file))
+    return _assemble(streams, Path(file).name, start_s, end_s, options)
 
 
 class _Options(NamedTuple):

@@ -128,6 +128,9 @@ def _load(path):
     except UnicodeDecodeError:
         raise PitotcalError(f"`columns` {path}: not valid TOML (binary content)",
                             param="columns") from None
+    except RecursionError:
+        raise PitotcalError(f"`columns` {path}: not valid TOML (nested too deeply)",
+                            param="columns") from None
     except OSError as exc:
         raise PitotcalError(f"`columns` {path}: cannot read it ({exc.strerror})",
                             param="columns") from None

@@ -36,15 +36,18 @@ def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None,
 
     from . import is_log_file, read_flight, with_reading
     from .flight_checks import check_window
+    from .read_once import log_suffix, read_once
 
-    if is_log_file(path):
+    path = read_once(path)          # a stream once, whole: each reader below gets its bytes
+    if is_log_file(path) or log_suffix(path):
         from .logs import load_log
 
         start_s, end_s = check_window(start_s, end_s)
         temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
         log = load_log(path, start_s, end_s, oat_k=oat_k)
         params = dict(log.airspeed_scale)
-        autopilot = "PX4" if Path(path).suffix.lower() == ".ulg" else "ArduPilot"
+        suffix = log_suffix(path) or Path(path).suffix.lower()
+        autopilot = "PX4" if suffix == ".ulg" else "ArduPilot"
         flight = with_static_air(log.flight, temp_recovery=temp_recovery, rh_pct=rh_pct)
         return with_reading(flight, {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                                      "temp_recovery": temp_recovery, "rh_pct": rh_pct}), \

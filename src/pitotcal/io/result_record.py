@@ -8,6 +8,7 @@ GPS error and the reading were part of them (`RECORD_KEYS`) are read as they are
 """
 
 import math
+import os
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import MAX_PRESSURE_ERROR, MODELS, get_model, worst_pressure_error
@@ -51,7 +52,7 @@ def read_result(source, *, name=None, table=True):
     Parameters
     ----------
     source : str, path-like or dict
-        The JSON file, or its content already parsed.
+        The JSON file, or its content already parsed (anything but an object is refused).
     name : str, optional
         How errors name the record (e.g. ``"--calibration result.json"``); default the path,
         or ``"<memory>"`` for a dict.
@@ -73,7 +74,8 @@ def read_result(source, *, name=None, table=True):
         coefficient's value) missing, or any known key of the wrong type (the wind's
         parameters included).
     """
-    if isinstance(source, dict):
+    if not isinstance(source, (str, os.PathLike)):
+        # a document already parsed (an object, or whatever else the JSON held)
         label, doc = name or "<memory>", source
     else:
         label = name or str(source)
@@ -128,7 +130,12 @@ def _check_pressure_error(label, doc):
     """The record's pressure error |f(q_ci; k)| within MAX_PRESSURE_ERROR at the speeds of its
     table (the rule `simulate` holds its truth to), or |k1| without a table."""
     model = get_model(doc["model"])
-    k = [float(doc["parameters"][name]["value"]) for name in model.params]
+    k = [doc["parameters"][name]["value"] for name in model.params]
+    for name, value in zip(model.params, k):
+        if value is None:       # its table, if any, is no calibration's either
+            raise PitotcalError(f"{label}: key 'parameters.{name}.value' is null: the fit gave "
+                                "no value, so the record is not a calibration",
+                                param=f"parameters.{name}.value")
     vi = [row["vi_kt"] for row in doc.get("airspeed_correction", ())]
     worst = (worst_pressure_error(model, k, vi, doc.get("air_data", "incompressible")) if vi
              else abs(k[0]))
