@@ -161,7 +161,7 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
     start = np.array([0.0, 0.0, 0.0, min(max(0.98, r_lo), r_hi), 0.0])[:scale.size]
     lower = np.full(scale.size, -np.inf)
     upper = np.full(scale.size, np.inf)
-    lower[3], upper[3] = r_lo, r_hi
+    lower[3], upper[3] = r_lo, max(r_hi, r_lo + 1e-9)         # low = high: r fixed
     sol = least_squares(_residual, start / scale, x_scale=1.0, args=(data, fit, profile),
                         method="trf", bounds=(lower / scale, upper / scale))
     x = sol.x * scale
@@ -187,14 +187,14 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
 
 
 def _recovery_bounds(bounds):
-    """`recovery_bounds` checked: 0 < low <= high <= 1.2."""
+    """`recovery_bounds` checked: 0 < low <= high <= 1.5 (above 1 only to reproduce a peer)."""
     try:
         lo, hi = (float(b) for b in bounds)
     except (TypeError, ValueError):
         raise PitotcalError(f"`recovery_bounds` {bounds!r} must be two numbers (low, high)",
                             param="recovery_bounds") from None
-    if not 0.0 < lo <= hi <= 1.2:
-        raise PitotcalError(f"`recovery_bounds` {bounds!r} must satisfy 0 < low <= high <= 1.2",
+    if not 0.0 < lo <= hi <= 1.5:
+        raise PitotcalError(f"`recovery_bounds` {bounds!r} must satisfy 0 < low <= high <= 1.5",
                             param="recovery_bounds")
     return lo, hi
 
