@@ -39,7 +39,7 @@ __all__ = ["MACH_GRID", "RECOVERY_BOUNDS", "MachFitResult", "identify_mach"]
 # A probe recovers at most the whole stagnation rise (r = 1); an unshielded one about 0.6-0.8.
 RECOVERY_BOUNDS = (0.5, 1.0)
 # M_ic where the curve is tabulated (within the data's range).
-MACH_GRID = tuple(np.round(np.arange(0.4, 3.0001, 0.05), 2))
+MACH_GRID = tuple(np.round(np.arange(0.4, 3.0001, 0.025), 3))
 _CP_JKGK = GAMMA * R_AIR_JKGK / (GAMMA - 1.0)
 # The first pass's output scales (Pa, K): a 0.3 m/s airspeed at 250 m/s and 0.5 kg/m³, a probe's
 # fraction of a kelvin; the second pass uses the first's residual RMS.
