@@ -51,7 +51,7 @@ static_pressure   = { column = "static_pres_psi", unit = "psi" }
 total_temperature = { column = "total_temp_K",    unit = "K" }
 gps_height        = { column = "height_ft",       unit = "ft" }
 """
-# M_ic where the methods' curves are compared (the issue's 0.55-0.9).
+# M_ic where the methods' curves are compared: below the transonic rise, where JMOSS's curve holds.
 COMPARE_MACH_IC = tuple(np.round(np.arange(0.55, 0.9001, 0.05), 2))
 _COLUMNS = ("point", "method", "altitude_ft", "wind_n_kt", "wind_e_kt", "wind_2sigma_kt",
             "wind_miss_kt", "oat_k", "oat_2sigma_k", "oat_minus_sonde_k", "recovery",
@@ -148,14 +148,14 @@ class JetsStudy:
     """The `jets` study (module notes): one run, in process."""
 
     name: str = NAME
-    description: str = ("real jet test points (CLASS*.csv in --data) through Mach 1: output "
+    description: str = ("real jet test points (the folder's CLASS*.csv) through Mach 1: output "
                         "error with a Mach-dependent static error and the probe's recovery, "
                         "and the self-survey, against the radiosonde and JMOSS")
 
     def collect(self, settings):
         if settings.data_dir is None:
-            raise PitotcalError("study jets needs the folder of the test points: `data_dir` "
-                                "(--data DIR)", param="data_dir")
+            raise PitotcalError("study jets needs `data_dir`, the folder of the CLASS*.csv "
+                                "test points", param="data_dir")
         data = Path(settings.data_dir)
         files = sorted(data.glob("CLASS*.csv"))
         if not files:
