@@ -17,7 +17,7 @@ def plot_jets(out_dir, filename, points):
     from matplotlib.figure import Figure
 
     n = max(len(points), 1)
-    fig = Figure(figsize=(4.6 * n + 4.2, 4.4), layout="constrained")
+    fig = Figure(figsize=(4.6 * n + 4.2, 5.2), layout="constrained")
     axes = np.atleast_1d(fig.subplots(1, n + 1, gridspec_kw={"width_ratios": [1.0] * n + [0.8]}))
     for ax, p in zip(axes[:-1], points):
         _curves(ax, p)
@@ -76,4 +76,4 @@ def _misses(ax, points):
     ax.set_xlim(-0.5, len(have) - 0.5)
     ax.set_title("against the radiosonde (±4 dotted)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=6.5, loc="lower left")
+    ax.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=1)
