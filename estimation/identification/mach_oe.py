@@ -201,6 +201,11 @@ def _data(flight):
                                 "static port and a total-temperature probe", param="flight")
     ps = np.asarray(flight.ps_pa, dtype=float)
     qci = np.asarray(flight.qci_pa, dtype=float)
+    for name in ("ps_pa", "tat_k", "qci_pa", "gps_vn_mps", "gps_ve_mps"):
+        values = np.asarray(getattr(flight, name), dtype=float)
+        if not np.all(np.isfinite(values)) or (name in ("ps_pa", "tat_k") and np.any(values <= 0)):
+            raise PitotcalError(f"`flight` {name} has a sample that is not a positive finite "
+                                "number", param="flight")
     ratio = np.clip(qci / ps, 0.0, QC_OVER_PS_MAX)
     mach_ic = mach_from_qc(ratio, 1.0)
     vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(ps.size)

@@ -44,7 +44,8 @@ def _curves(ax, p):
                 ls="--", lw=1.5, label=f"{label}, its r = {jm['recovery']:.2f}")
     ours = np.concatenate([v - w, v + w, [s["dpp_ps"] for s in ss["spe"]]])
     pad = 0.1 * (np.max(ours) - np.min(ours))
-    ax.set_ylim(np.min(ours) - pad, np.max(ours) + pad)     # JMOSS's polynomial runs off above M_ic 0.97
+    # JMOSS's polynomial runs off above M_ic 0.97: the scale is ours
+    ax.set_ylim(np.min(ours) - pad, np.max(ours) + pad)
     ax.set_title(f"{p['name']}, {p['altitude_ft']:,.0f} ft")
     ax.set_xlabel("M_ic")
     ax.set_ylabel("Δp_p / p_s")

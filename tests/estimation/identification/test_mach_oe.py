@@ -100,3 +100,11 @@ def test_a_flight_without_a_probe_is_refused():
     flight = jet_point(0, hz=1.0)
     with pytest.raises(PitotcalError, match="`flight` has no tat_k"):
         identify_mach(Flight(**{**flight.__dict__, "tat_k": None}))
+
+
+def test_a_flight_with_a_bad_sample_is_refused():
+    flight = jet_point(0, hz=1.0)
+    tat = flight.tat_k.copy()
+    tat[3] = np.nan
+    with pytest.raises(PitotcalError, match="`flight` tat_k has a sample"):
+        identify_mach(Flight(**{**flight.__dict__, "tat_k": tat}))
