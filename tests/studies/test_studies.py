@@ -49,9 +49,9 @@ LEAN = {  # name -> (runs, study columns, study summary keys, headline pattern)
 def test_every_study_follows_the_one_protocol():
     # the Monte Carlo ones here; peers in test_baselines.py, real-alfa in test_real_alfa.py,
     # legs and legs-flight in test_legs_study.py, monitor in test_monitor_study.py, noise in
-    # test_noise_study.py, leak in test_leak_study.py
+    # test_noise_study.py, leak in test_leak_study.py, jets in jets/test_jets.py
     assert set(LEAN) | {"peers", "real-alfa", "legs", "legs-flight", "monitor", "noise",
-                        "leak"} == set(STUDIES)
+                        "leak", "jets"} == set(STUDIES)
     for name, study in STUDIES.items():
         assert isinstance(study, Study) and study.name == name and study.description
 
