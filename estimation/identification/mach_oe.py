@@ -34,7 +34,8 @@ from pitotcal.core.units import ISA_LAPSE_KPM, R_AIR_JKGK, m_to_ft, mps_to_kt
 
 from ..uncertainty.covariance import colored_covariance
 
-__all__ = ["MACH_GRID", "RECOVERY_BOUNDS", "MachFitResult", "identify_mach"]
+__all__ = ["MACH_GRID", "RECOVERY_BOUNDS", "MachFitResult", "identify_mach",
+           "position_corrections"]
 
 # A probe recovers at most the whole stagnation rise (r = 1); an unshielded one about 0.6-0.8.
 RECOVERY_BOUNDS = (0.5, 1.0)
@@ -235,6 +236,20 @@ def _residual(xs, data, scale, weights):
     return np.concatenate([r_q / weights[0], r_t / weights[1]])
 
 
+def position_corrections(mach_ic, dpp_ps, psi_pa):
+    """(ΔV_pc kt, ΔM_pc, ΔH_pc ft) of a static error Δp_p/p_s = (p_si − p_s)/p_si at M_ic and
+    the indicated static pressure `psi_pa`, with p_T exact: q_c = q_ci + p_si Δp_p/p_s."""
+    mach_ic = np.asarray(mach_ic, dtype=float)
+    g = np.asarray(dpp_ps, dtype=float)
+    qci = qc_from_mach_pa(mach_ic, psi_pa)
+    ps = psi_pa * (1.0 - g)
+    qc = qci + psi_pa * g
+    dv = mps_to_kt(cas_from_qc_mps(qc) - cas_from_qc_mps(qci))
+    dm = mach_from_qc(qc, ps) - mach_ic
+    dh = m_to_ft(pressure_altitude_m(ps) - pressure_altitude_m(np.full(mach_ic.shape, psi_pa)))
+    return dv, dm, dh
+
+
 def _table(result, data):
     """The curve on `MACH_GRID` within the data, with ΔV_pc, ΔM_pc, ΔH_pc at the median p_si."""
     lo, hi = float(np.min(data["mach_ic"])), float(np.max(data["mach_ic"]))
@@ -242,13 +257,7 @@ def _table(result, data):
     if grid.size == 0:
         return []
     g, g2s = result.dpp_ps(grid)
-    psi = float(np.median(data["ps_pa"]))
-    qci = qc_from_mach_pa(grid, psi)
-    ps = psi * (1.0 - g)
-    qc = qci + psi * g                      # p_T exact: q_c = p_T − p_s
-    dv = mps_to_kt(cas_from_qc_mps(qc) - cas_from_qc_mps(qci))
-    dm = mach_from_qc(qc, ps) - grid
-    dh = m_to_ft(pressure_altitude_m(ps) - pressure_altitude_m(np.full(grid.size, psi)))
+    dv, dm, dh = position_corrections(grid, g, float(np.median(data["ps_pa"])))
     return [{"mach_ic": float(m), "dpp_ps": float(a), "dpp_ps_2sigma": float(b),
              "dv_kt": float(v), "dm": float(d), "dh_ft": float(h)}
             for m, a, b, v, d, h in zip(grid, g, g2s, dv, dm, dh)]

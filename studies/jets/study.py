@@ -28,7 +28,7 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import m_to_ft, mps_to_kt
-from pitotcal.estimation.identification.mach_oe import identify_mach
+from pitotcal.estimation.identification.mach_oe import identify_mach, position_corrections
 from pitotcal.estimation.survey import self_survey
 from pitotcal.io.mapped_csv import read_mapped_csv
 from pitotcal.io.radiosonde import read_sounding
@@ -73,12 +73,23 @@ def calibrate_point(path, mapping, sonde=None):
     ss_s = time.perf_counter() - start
     entry = _method_entry(Path(path).stem, h_m, oe.to_dict(), at, oe_s)
     entry["n_samples"] = int(flight.n)
-    entry["self_survey"] = _method_entry(Path(path).stem, h_m, ss.to_dict(), at, ss_s)
+    entry["self_survey"] = _method_entry(Path(path).stem, h_m, _with_corrections(
+        ss.to_dict(), float(np.median(flight.ps_pa))), at, ss_s)
     if at is not None:
         entry["radiosonde"] = {"wind_n_kt": float(mps_to_kt(at["wind_n_mps"])),
                                "wind_e_kt": float(mps_to_kt(at["wind_e_mps"])),
                                "temp_k": at["temp_k"], "ps_pa": at["ps_pa"]}
     return entry
+
+
+def _with_corrections(d, psi_pa):
+    """The self-survey's bins with ΔV_pc, ΔM_pc, ΔH_pc at the point's median p_si."""
+    m = np.array([s["mach_ic"] for s in d["spe"]])
+    g = np.array([s["dpp_ps"] for s in d["spe"]])
+    dv, dm, dh = position_corrections(m, g, psi_pa)
+    spe = [{**s, "dv_kt": float(v), "dm": float(a), "dh_ft": float(h)}
+           for s, v, a, h in zip(d["spe"], dv, dm, dh)]
+    return {**d, "spe": spe}
 
 
 def _method_entry(name, h_m, d, at, elapsed_s):

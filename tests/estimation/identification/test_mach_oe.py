@@ -108,3 +108,18 @@ def test_a_flight_with_a_bad_sample_is_refused():
     tat[3] = np.nan
     with pytest.raises(PitotcalError, match="`flight` tat_k has a sample"):
         identify_mach(Flight(**{**flight.__dict__, "tat_k": tat}))
+
+
+def test_position_corrections_follow_the_static_error():
+    """No error, no correction; Δp_p/p_s 0.02 at M_ic 0.9 and 46 kPa: the true static pressure
+    2 % lower, so the altitude higher (ISA) and V_c, M above V_ic, M_ic."""
+    from pitotcal.core.airdata import pressure_altitude_m
+    from pitotcal.core.units import m_to_ft
+    from pitotcal.estimation.identification.mach_oe import position_corrections
+
+    zero = position_corrections([0.6, 0.9], [0.0, 0.0], 46000.0)
+    assert np.all(np.abs(np.array(zero)) < 1e-9)
+    dv, dm, dh = position_corrections([0.9], [0.02], 46000.0)
+    assert dh[0] == pytest.approx(m_to_ft(pressure_altitude_m(46000.0 * 0.98)
+                                          - pressure_altitude_m(46000.0)), rel=1e-9)
+    assert 400.0 < dh[0] < 600.0 and 3.0 < dv[0] < 8.0 and 0.01 < dm[0] < 0.03

@@ -34,7 +34,8 @@ def test_files_and_keys(jets):
     assert [p["name"] for p in points] == ["CLASS55", "CLASS65"]
     for p in points:
         assert KEYS <= set(p) and KEYS <= set(p["self_survey"])
-        assert {"mach_ic", "dpp_ps", "dpp_ps_2sigma"} <= set(p["spe"][0])
+        for spe in (p["spe"], p["self_survey"]["spe"]):
+            assert {"mach_ic", "dpp_ps", "dpp_ps_2sigma", "dv_kt", "dm", "dh_ft"} <= set(spe[0])
     assert len((out / "jets.csv").read_text().splitlines()) == 1 + 2 * 2
 
 
