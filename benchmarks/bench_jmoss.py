@@ -115,6 +115,7 @@ def run_pitotcal(files, sounding_path):
 
     from pitotcal.core.units import mps_to_kt
     from pitotcal.estimation.identification.identify import identify
+    from pitotcal.estimation.identification.mach_oe import identify_mach
     from pitotcal.estimation.survey import self_survey
     from pitotcal.io import read_flight
     from pitotcal.io.mapped_csv import read_attitude, read_mapped_csv
@@ -127,11 +128,12 @@ def run_pitotcal(files, sounding_path):
         mapping = Path(tmp) / "jmoss.toml"
         mapping.write_text(MAPPING)
         for path in files:
-            survey = self_survey(read_mapped_csv(path, mapping, mach_ic_max=1.0))
-            vector = self_survey(read_mapped_csv(path, mapping, mach_ic_max=1.0),
+            survey = self_survey(read_mapped_csv(path, mapping))
+            vector = self_survey(read_mapped_csv(path, mapping),
                                  attitude=read_attitude(path, mapping))
             flight = read_flight(path, columns=mapping)
             oe = identify(flight, model="inverse")
+            mach = identify_mach(flight)
             wn, we = _wind_ne(oe)
             entry = {"self_survey": {**survey.to_dict(),
                                      "wind_ne_kt": [float(mps_to_kt(survey.wind_n_mps)),
@@ -143,6 +145,8 @@ def run_pitotcal(files, sounding_path):
                                       "wind_speed_2sigma_kt": float(mps_to_kt(
                                           2 * oe.stddev("wind_speed_mps"))),
                                       "oat_k_assumed_r1": float(np.mean(flight.oat_k))},
+                     "output_error_mach": {**mach.to_dict(), "wind_ne_kt": [
+                         float(mps_to_kt(mach.wind_n_mps)), float(mps_to_kt(mach.wind_e_mps))]},
                      "h_ref_m": survey.h_ref_m}
             if sonde is not None:
                 at = sonde.at(survey.h_ref_m)
@@ -199,7 +203,9 @@ def _summary(result):
                                   ("self_survey_vector", r["self_survey_vector"]["wind_ne_kt"],
                                    r["self_survey_vector"]["oat_k"]),
                                   ("output_error", r["output_error"]["wind_ne_kt"],
-                                   r["output_error"]["oat_k_assumed_r1"])):
+                                   r["output_error"]["oat_k_assumed_r1"]),
+                                  ("output_error_mach", r["output_error_mach"]["wind_ne_kt"],
+                                   r["output_error_mach"]["oat_k"])):
             row[method] = {"wind_ne_kt": [round(w, 2) for w in wind], "oat_k": round(oat, 2)}
             if sonde:
                 row[method]["wind_diff_kt"] = round(float(np.hypot(

@@ -26,6 +26,7 @@ from .accuracy.maneuvers import STUDY as MANEUVERS
 from .monitor.study import STUDY as MONITOR
 from .accuracy.noise import STUDY as NOISE
 from .real_alfa.study import STUDY as REAL_ALFA
+from .jets.study import STUDY as JETS
 from .engine.runner import RunsInterrupted, count_errors, output_folder, write_table
 from .accuracy.sample_size import STUDY as SAMPLE_SIZE
 from .accuracy.sensitivity import STUDY as SENSITIVITY
@@ -41,7 +42,7 @@ log = logging.getLogger(__name__)
 STUDIES = {s.name: s for s in (SAMPLE_SIZE, MANEUVERS, SENSITIVITY, COVERAGE, WIND, REAL_ALFA,
                                PEERS, LEGS, DESIGN, MONITOR, BUDGET,
                                LEGS_FLIGHT, NOISE,
-                               LEAK, COVERAGE_TAILS)}
+                               LEAK, COVERAGE_TAILS, JETS)}
 
 
 class StudyInterrupted(KeyboardInterrupt):

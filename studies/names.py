@@ -3,4 +3,4 @@ parser from them without loading the studies); `studies.catalog.STUDIES` holds t
 
 STUDY_NAMES = ("sample-size", "maneuvers", "sensitivity", "coverage", "wind", "real-alfa",
                "peers", "legs", "design", "monitor", "budget", "legs-flight", "noise",
-               "leak", "coverage-tails")
+               "leak", "coverage-tails", "jets")

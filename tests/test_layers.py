@@ -132,7 +132,7 @@ SUBLAYERS = {
                             "monitor": 3, "legs": 3, "reporting": 4, "live": 5, "__init__": 6},
     "pitotcal.maneuvers": {"turbulence": 0, "plan": 1, "fly": 2, "__init__": 3},
     "pitotcal.studies": {"names": 0, "engine": 0, "accuracy": 1, "design": 1, "legs": 1,
-                         "monitor": 1, "peers": 1, "real_alfa": 2, "catalog": 3, "demo": 3,
+                         "monitor": 1, "peers": 1, "real_alfa": 2, "jets": 2, "catalog": 3, "demo": 3,
                          "__init__": 4},
 }
 

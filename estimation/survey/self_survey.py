@@ -21,9 +21,11 @@ with no model of how Δp_p depends on M_ic: the curve is whatever the data say, 
 transonic region. With the attitude and the sideslip vane given, the airspeed is compared as a
 vector, V_t u + W = V_g (u its direction, `airspeed_direction`), and the vertical wind is
 fitted too. The profile's T̄ is the probe's temperature with r = 1 at M_ic: over the few tens
-of metres of a level test point its error moves p(h) by far less than its stated bound. Samples with M_ic above `MACH_IC_FIT_MAX` enter the curve but not the fit
-(their true Mach number may pass 1, where the subsonic pitot relation of the fit does not
-hold); samples above M_ic 1 are left out until the supersonic relation is in.
+of metres of a level test point its error moves p(h) by far less than its stated bound. Every
+sample enters the fit and the curve, through Mach 1: the Mach numbers come from the pitot
+relations of `pitotcal.core.airdata` (Rayleigh above M 1). The recovery factor is bounded
+(`recovery_bounds`, default 0.5 to 1: a probe recovers at most the whole stagnation rise);
+at a bound `recovery_at_bound` says so and the covariance is the local one there.
 
 Bounds (2σ) of each M_ic bin combine: the fitted unknowns' covariance (colored residuals,
 `estimation.uncertainty.covariance`), the scatter of the bin's samples, a GPS height drift
@@ -37,19 +39,19 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from pitotcal.core import checks
-from pitotcal.core.airdata import GAMMA, mach_from_qc, qc_from_mach_pa
+from pitotcal.core.airdata import GAMMA, QC_OVER_PS_MAX, mach_from_qc
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import G0_MPS2, ISA_LAPSE_KPM, R_AIR_JKGK
 
 from ..uncertainty.covariance import colored_covariance
 from .airspeed_direction import airspeed_direction, aligned_attitude
 
-__all__ = ["LAPSE_SIGMA_KPM", "MACH_IC_FIT_MAX", "SelfSurveyResult", "hydrostatic_pressure_pa",
+__all__ = ["LAPSE_SIGMA_KPM", "RECOVERY_BOUNDS", "SelfSurveyResult", "hydrostatic_pressure_pa",
            "self_survey"]
 
-MACH_IC_FIT_MAX = 0.95
 LAPSE_SIGMA_KPM = 0.003          # a real profile's lapse rate, 1σ about the standard one
-_MACH_1_RATIO = float(qc_from_mach_pa(1.0, 1.0))
+# A probe recovers at most the whole stagnation rise (r = 1); an unshielded one about 0.6-0.8.
+RECOVERY_BOUNDS = (0.5, 1.0)
 # unknowns: (p_ref/p̄_s − 1), W_n, W_e, r, and W_d with the vector airspeed
 _SCALE = np.array([1e-2, 1.0, 1.0, 1.0, 1.0])
 _NAMES = ("p_ref_pa", "wind_n_mps", "wind_e_mps", "recovery", "wind_d_mps")
@@ -74,10 +76,13 @@ class SelfSurveyResult:
     oat_k, oat_2sigma_k : float
         The test point's mean static temperature and its 2σ.
     mach_ic, dpp_ps : ndarray
-        Per sample: M_ic and Δp_p/p_s (samples up to M_ic 1).
+        Per sample: M_ic and Δp_p/p_s (every sample, through Mach 1).
     spe : list of dict
         The curve by M_ic bin: {"mach_ic", "dpp_ps", "dpp_ps_2sigma", "n"}.
     n_fit, n_excluded_supersonic : int
+        Samples fitted; samples beyond the pitot relations' Mach range (none in a real flight).
+    recovery_at_bound : bool
+        The fitted recovery factor sits on a bound of `recovery_bounds`.
     """
 
     success: bool
@@ -97,6 +102,7 @@ class SelfSurveyResult:
     n_excluded_supersonic: int
     airspeed_model: str = "magnitude"
     wind_d_mps: float = 0.0
+    recovery_at_bound: bool = False
 
     def std(self, name):
         """1σ of "p_ref_pa", "wind_n_mps", "wind_e_mps", "recovery" or "wind_d_mps"."""
@@ -111,13 +117,14 @@ class SelfSurveyResult:
                 "wind_d_mps": self.wind_d_mps,
                 "wind_2sigma_mps": 2.0 * max(self.std("wind_n_mps"), self.std("wind_e_mps")),
                 "recovery": self.recovery, "recovery_2sigma": 2.0 * self.std("recovery"),
+                "recovery_at_bound": self.recovery_at_bound,
                 "p_ref_pa": self.p_ref_pa, "h_ref_m": self.h_ref_m, "oat_k": self.oat_k,
                 "oat_2sigma_k": self.oat_2sigma_k, "n_fit": self.n_fit,
                 "n_excluded_supersonic": self.n_excluded_supersonic, "spe": self.spe}
 
 
 def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
-                oat_sigma_k=2.0):
+                oat_sigma_k=2.0, recovery_bounds=RECOVERY_BOUNDS):
     """Static position error Δp_p/p_s against M_ic by the self-survey (module notes).
 
     Parameters
@@ -136,6 +143,8 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
         1σ drift of the GPS height over the test point, m (it moves p(h) by g/(R T) per m).
     oat_sigma_k : float
         1σ of the hydrostatic profile's mean temperature, K.
+    recovery_bounds : (float, float)
+        Lowest and highest recovery factor of the probe (module notes).
 
     Returns
     -------
@@ -144,13 +153,17 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
     bin_width = checks.number("bin_width", bin_width, 1e-3, 0.5)
     height_drift_m = checks.number("height_drift_m", height_drift_m, 0.0, 100.0)
     oat_sigma_k = checks.number("oat_sigma_k", oat_sigma_k, 0.0, 50.0)
+    r_lo, r_hi = _recovery_bounds(recovery_bounds)
     data = _data(flight, attitude)
-    fit = data["ratio"] <= float(qc_from_mach_pa(MACH_IC_FIT_MAX, 1.0))
+    fit = np.ones(data["ratio"].size, dtype=bool)
     profile = (data["oat0_k"], ISA_LAPSE_KPM)
     scale = _SCALE[:5 if "u" in data else 4]
-    start = np.array([0.0, 0.0, 0.0, 1.0, 0.0])[:scale.size]
+    start = np.array([0.0, 0.0, 0.0, min(max(0.98, r_lo), r_hi), 0.0])[:scale.size]
+    lower = np.full(scale.size, -np.inf)
+    upper = np.full(scale.size, np.inf)
+    lower[3], upper[3] = r_lo, max(r_hi, r_lo + 1e-9)         # low = high: r fixed
     sol = least_squares(_residual, start / scale, x_scale=1.0, args=(data, fit, profile),
-                        method="trf")
+                        method="trf", bounds=(lower / scale, upper / scale))
     x = sol.x * scale
     cov_x = colored_covariance(sol.jac, sol.fun, window="exponential").covariance \
         * np.outer(scale, scale)
@@ -169,12 +182,26 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
         spe=_binned(data["mach_ic"], dpp, spread, bin_width, data["time_s"]),
         n_fit=int(np.count_nonzero(fit)), n_excluded_supersonic=data["n_super"],
         airspeed_model="vector" if "u" in data else "magnitude",
-        wind_d_mps=float(x[4]) if x.size > 4 else 0.0)
+        wind_d_mps=float(x[4]) if x.size > 4 else 0.0,
+        recovery_at_bound=bool(min(x[3] - r_lo, r_hi - x[3]) < 1e-6))
+
+
+def _recovery_bounds(bounds):
+    """`recovery_bounds` checked: 0 < low <= high <= 1.5 (above 1 only to reproduce a peer)."""
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise PitotcalError(f"`recovery_bounds` {bounds!r} must be two numbers (low, high)",
+                            param="recovery_bounds") from None
+    if not 0.0 < lo <= hi <= 1.5:
+        raise PitotcalError(f"`recovery_bounds` {bounds!r} must satisfy 0 < low <= high <= 1.5",
+                            param="recovery_bounds")
+    return lo, hi
 
 
 def _data(flight, attitude=None):
-    """The arrays the survey needs, SI, samples up to M_ic 1; `u` the airspeed's direction
-    when the attitude is given."""
+    """The arrays the survey needs, SI, every sample in the pitot relations' range; `u` the
+    airspeed's direction when the attitude is given."""
     for name in ("ps_pa", "alt_m", "tat_k"):
         if getattr(flight, name) is None:
             raise PitotcalError(f"`flight` has no {name}: the self-survey needs the static "
@@ -182,7 +209,7 @@ def _data(flight, attitude=None):
                                 param="flight")
     ps = np.asarray(flight.ps_pa, dtype=float)
     ratio = np.asarray(flight.qci_pa, dtype=float) / ps
-    keep = (ratio <= _MACH_1_RATIO) & np.isfinite(flight.alt_m)
+    keep = (np.abs(ratio) <= QC_OVER_PS_MAX) & np.isfinite(flight.alt_m)
     vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(ps.size)
     h = np.asarray(flight.alt_m, dtype=float)[keep]
     oat0 = np.asarray(flight.tat_k)[keep] / (1.0 + 0.2 * mach_from_qc(ratio[keep], 1.0) ** 2)
@@ -197,7 +224,7 @@ def _data(flight, attitude=None):
             "mach_ic": mach_from_qc(ratio[keep], 1.0), "ps_mean_pa": float(np.mean(ps[keep])),
             "oat0_k": float(np.mean(oat0)),
             "vg": vg,
-            "n_super": int(np.count_nonzero(ratio > _MACH_1_RATIO))}
+            "n_super": int(np.count_nonzero(np.abs(ratio) > QC_OVER_PS_MAX))}
 
 
 def hydrostatic_pressure_pa(h_m, h_ref_m, p_ref_pa, t_ref_k, lapse_kpm=ISA_LAPSE_KPM):
@@ -223,7 +250,7 @@ def _static_pa(data, x, profile):
 
 
 def _true_mach(data, p):
-    ratio = np.clip((data["pt_pa"] - p) / p, 0.0, _MACH_1_RATIO)
+    ratio = np.clip((data["pt_pa"] - p) / p, 0.0, QC_OVER_PS_MAX)
     return mach_from_qc(ratio, 1.0)
 
 

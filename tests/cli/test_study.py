@@ -113,3 +113,13 @@ def test_runs_above_the_cap_are_refused_with_the_cap(capsys):
     err = capsys.readouterr().err.strip()
     assert err == ("pitotcal study: --runs 100000000 is more than one study takes (100000, "
                    "held in memory): run several studies, each with its own --seed")
+
+
+def test_jets_needs_a_folder_of_test_points(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "jets"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("pitotcal study: study jets needs `--data`, the folder of the CLASS*.csv "
+                   "test points\n")
+    assert main(["study", "jets", "--data", str(tmp_path)]) == 2
+    assert "has no CLASS*.csv test point" in capsys.readouterr().err

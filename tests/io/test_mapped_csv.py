@@ -120,16 +120,24 @@ def test_the_mapping_is_returned_key_by_key(tmp_path):
     assert got["total_pressure"] == ("pt_psi", "psi") and len(got) == 8
 
 
-@pytest.mark.parametrize("point, n, left_out", [("CLASS55", 8708, 177), ("CLASS65", 7961, 217)])
-def test_real_jet_exports_load_as_they_are(point, n, left_out, shared_file, tmp_path):
-    """The USAF TPS exports (ft/s, psi, K, ft) load without a converter; samples above M_ic
-    0.95 are left out with one warning until the supersonic pitot relation is in."""
+@pytest.mark.parametrize("point, n, above_1", [("CLASS55", 8885, 77), ("CLASS65", 8178, 128)])
+def test_real_jet_exports_load_as_they_are(point, n, above_1, shared_file, tmp_path):
+    """The USAF TPS exports (ft/s, psi, K, ft) load without a converter, every row through
+    Mach 1 (the Rayleigh pitot relation holds above it); `mach_ic_max` still cuts on request."""
+    from pitotcal.core.airdata import mach_from_qc
+    from pitotcal.io.mapped_csv import read_mapped_csv
+
     path = shared_file(f"jmoss/{point}.csv")
+    mapping = _map_with(tmp_path, JMOSS_MAP)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        flight = read_flight(path, columns=_map_with(tmp_path, JMOSS_MAP))
-    assert flight.n == n and flight.meta["excluded_supersonic"] == left_out
-    assert any("above M_ic 0.95" in str(w.message) for w in caught)
+        flight = read_flight(path, columns=mapping)
+    assert flight.n == n and flight.meta["excluded_supersonic"] == 0
+    assert not any("above M_ic" in str(w.message) for w in caught)
+    assert np.count_nonzero(mach_from_qc(flight.qci_pa, flight.ps_pa) > 1.0) == above_1
+    with pytest.warns(UserWarning, match="above M_ic 0.95"):
+        cut = read_mapped_csv(path, mapping, mach_ic_max=0.95)
+    assert cut.n < n and cut.meta["excluded_supersonic"] == n - cut.n
     assert 5900 < np.median(flight.alt_m) < 6600 and 4e4 < np.median(flight.ps_pa) < 5.5e4
 
 

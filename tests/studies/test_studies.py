@@ -49,9 +49,10 @@ LEAN = {  # name -> (runs, study columns, study summary keys, headline pattern)
 def test_every_study_follows_the_one_protocol():
     # the Monte Carlo ones here; peers in test_baselines.py, real-alfa in test_real_alfa.py,
     # legs and legs-flight in test_legs_study.py, monitor in test_monitor_study.py, noise in
-    # test_noise_study.py, leak in test_leak_study.py, coverage-tails in accuracy/test_tails.py
+    # test_noise_study.py, leak in test_leak_study.py, coverage-tails in accuracy/test_tails.py,
+    # jets in jets/test_jets.py
     assert set(LEAN) | {"peers", "real-alfa", "legs", "legs-flight", "monitor", "noise",
-                        "leak", "coverage-tails"} == set(STUDIES)
+                        "leak", "coverage-tails", "jets"} == set(STUDIES)
     for name, study in STUDIES.items():
         assert isinstance(study, Study) and study.name == name and study.description
 

@@ -29,7 +29,8 @@ def add_parser(subparsers):
     p.add_argument("--quick", action="store_true", help="small grid (smoke runs, CI)")
     p.add_argument("--data", dest="data_dir", default=None, metavar="DIR",
                    help="real-alfa: folder of the ALFA flight CSVs (default: "
-                        "${alfa_env}, else ./{alfa_dir})")
+                        "${alfa_env}, else ./{alfa_dir}); jets: folder of the CLASS*.csv "
+                        "test points (with WB.txt, the radiosonde, when present)")
     p.add_argument("--engine", default="own", choices=("own", "jsbsim"),
                    help="flight model of the simulated runs: own (default) or jsbsim "
                         "(JSBSim's {aircraft}; the coverage and noise studies)")

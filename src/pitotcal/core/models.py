@@ -19,6 +19,8 @@ __all__ = [
     "delta_v_kt",
     "delta_v_kt_where_defined",
     "get_model",
+    "mach_knots",
+    "mach_spline_basis",
     "qc_from_qci_pa",
     "qci_from_qc_pa",
     "worst_pressure_error",
@@ -144,3 +146,90 @@ def worst_pressure_error(model, k, vi_kt, air_data="incompressible"):
     with np.errstate(all="ignore"):
         ratio = np.abs(np.asarray(model(k, qci), dtype=float))
     return float(np.max(np.where(np.isfinite(ratio), ratio, np.inf))) if ratio.size else 0.0
+
+
+# Knot spacing of the Mach-dependent static error: coarse where it varies slowly, dense through
+# the transonic rise and fall (a shock crossing the static port moves it by 0.02 within 0.05 of
+# M_ic); the last entry covers supersonic flight.
+_KNOT_SPACING = ((0.8, 0.1), (0.9, 0.05), (1.1, 0.025), (3.0, 0.1))
+
+
+def mach_knots(mach_ic, min_samples=40):
+    """Knots of the Mach-dependent error chosen by the data, M_ic.
+
+    From the lowest to the highest M_ic of the samples, spaced by `_KNOT_SPACING` (0.1 below
+    M_ic 0.8, 0.05 to 0.9, 0.025 to 1.1); a knot is dropped when fewer than `min_samples`
+    samples lie between it and the previous one, so each coefficient is fitted by data.
+
+    Parameters
+    ----------
+    mach_ic : ndarray
+        M_ic of the samples.
+    min_samples : int
+        The fewest samples between two knots.
+
+    Returns
+    -------
+    ndarray, shape (K,)
+        Increasing knots, K >= 2 (the ends of the data).
+    """
+    m = np.sort(np.asarray(mach_ic, dtype=float))
+    lo, hi = float(m[0]), float(m[-1])
+    starts = (0.0,) + tuple(top for top, _ in _KNOT_SPACING[:-1])
+    grid = np.concatenate([np.arange(start, top - 1e-9, step) for start, (top, step)
+                           in zip(starts, _KNOT_SPACING)])
+    grid = [lo] + [float(round(g, 6)) for g in grid if lo < g < hi]
+    knots = [lo]
+    for k in grid[1:] + [hi]:
+        if np.count_nonzero((m > knots[-1]) & (m <= k)) >= min_samples:
+            knots.append(k)
+    if knots[-1] != hi:
+        knots[-1] = hi
+    return np.array(knots if len(knots) >= 2 else [lo, hi])
+
+
+def _positive(u):
+    return 0.5 * (u + abs(u))
+
+
+def _natural_terms(x, knots):
+    """The truncated-power basis of the natural cubic spline (Hastie, Tibshirani & Friedman,
+    Elements of Statistical Learning, eq. 5.4-5.5): 1, x, d_k − d_(K−1), as a list."""
+    last = len(knots) - 1
+
+    def d(k):
+        return (_positive(x - knots[k]) ** 3 - _positive(x - knots[last]) ** 3) \
+            / (knots[last] - knots[k])
+    terms = [1.0 + 0.0 * x, x]
+    if last >= 2:
+        d_before = d(last - 1)
+        terms += [d(k) - d_before for k in range(last - 1)]
+    return terms
+
+
+def mach_spline_basis(mach_ic, knots):
+    """Cardinal basis of the natural cubic spline through `knots`: f(M) = B(M) @ values.
+
+    Parameters
+    ----------
+    mach_ic : ndarray (N,) or CasADi MX
+        M_ic where the spline is evaluated; plain arithmetic, so MX works too (then a list of
+        MX columns is returned).
+    knots : sequence of float
+        Increasing knots (`mach_knots`), K of them.
+
+    Returns
+    -------
+    ndarray (N, K), or list of K MX
+        Column j is the natural cubic spline that is 1 at knot j and 0 at the others (linear
+        beyond the end knots), so the unknowns are the curve's values at the knots.
+    """
+    knots = np.asarray(knots, dtype=float)
+    at_knots = np.column_stack(_natural_terms(knots, knots))
+    to_cardinal = np.linalg.inv(at_knots)
+    terms = _natural_terms(mach_ic, knots)
+    if isinstance(mach_ic, np.ndarray) or np.isscalar(mach_ic):
+        return np.column_stack([np.broadcast_to(t, np.shape(mach_ic)) for t in terms]) \
+            @ to_cardinal
+    return [sum(float(to_cardinal[i, j]) * terms[i] for i in range(len(terms)))
+            for j in range(len(knots))]

@@ -18,11 +18,10 @@ message about a flight column also names the export's column it came from. The a
 (`roll`, `pitch`, `true_heading`, `sideslip`; rad or deg) are not flight columns: `read_attitude`
 reads them for the self-survey's vector airspeed.
 
-Samples above `MACH_IC_MAX` (0.95, the Mach number of the measured pressures) are left out
-with one warning: the air-data relations here are the subsonic (isentropic) ones until the
-supersonic pitot relation is in, and above M_ic 0.95 the true Mach number passes 1 once the
-static source reads 4 % of p_s high (a jet's transonic static error; M_ic 0.98 is M 1.01 then).
-`Flight.meta["excluded_supersonic"]` counts them.
+Every sample the pitot relations take is read, through Mach 1: above it the Rayleigh (normal
+shock) relation of `pitotcal.core.airdata` holds, so `MACH_IC_MAX` is the relations' own
+`MACH_MAX`. A caller may still leave out the samples whose measured pressures give a Mach
+number above `mach_ic_max` (one warning; `Flight.meta["excluded_supersonic"]` counts them).
 """
 
 import dataclasses
@@ -34,7 +33,7 @@ import warnings
 
 import numpy as np
 
-from pitotcal.core.airdata import qc_from_mach_pa
+from pitotcal.core.airdata import MACH_MAX, qc_from_mach_pa
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.units import (M_PER_UNIT, MPS_PER_UNIT, PA_PER_UNIT, RAD_PER_UNIT,
                                  S_PER_UNIT, TEMPERATURE_UNITS)
@@ -67,9 +66,8 @@ MAPPING_KEYS = {
 ATTITUDE_KEYS = ("roll", "pitch", "true_heading", "sideslip")
 _REQUIRED = ("time", "gps_vn", "gps_ve", "static_pressure")
 _ONE_OF = (("total_pressure", "impact_pressure"), ("total_temperature", "static_temperature"))
-MACH_IC_MAX = 0.95
-SUPERSONIC_NOTE = ("left out: above M_ic {:g}, where the true Mach number may pass 1 and the "
-                   "subsonic pitot relation does not hold")
+MACH_IC_MAX = MACH_MAX
+SUPERSONIC_NOTE = "left out: above M_ic {:g} (`mach_ic_max`)"
 
 
 def read_column_map(path):
@@ -152,7 +150,7 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
         As in `pitotcal.io.read_flight` (the window is in the mapped time, s).
     mach_ic_max : float
         Samples whose measured pressures give a Mach number above this are left out (module
-        notes); at most 1.
+        notes); the default keeps every sample the pitot relations take (Mach 0 to 3).
 
     Returns
     -------
@@ -167,8 +165,8 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
     FlightDataError
         Unusable data, as for a flight CSV; the message names the export's column.
     """
-    if not 0.0 < mach_ic_max <= 1.0:
-        raise PitotcalError(f"`mach_ic_max` {mach_ic_max!r} must be in (0, 1]",
+    if not 0.0 < mach_ic_max <= MACH_IC_MAX:
+        raise PitotcalError(f"`mach_ic_max` {mach_ic_max!r} must be in (0, {MACH_IC_MAX:g}]",
                             param="mach_ic_max")
     mapping, label, name, data, header_line = _mapped_data(path, columns)
     mapping = {k: v for k, v in mapping.items() if k not in ATTITUDE_KEYS}

@@ -122,3 +122,9 @@ def test_real_jet_vector_airspeed(shared_file, tmp_path):
     assert mps_to_kt(miss) < 4.0
     with pytest.raises(PitotcalError, match="`attitude` has no sample at the flight's time"):
         self_survey(flight, attitude={**attitude, "time_s": attitude["time_s"] + 0.01})
+
+
+@pytest.mark.parametrize("bounds", [(1.0, 0.9), (0.0, 1.0), "x", (0.5, 2.0)])
+def test_recovery_bounds_are_checked(flown, bounds):
+    with pytest.raises(PitotcalError, match="`recovery_bounds`"):
+        self_survey(flown[0], recovery_bounds=bounds)
