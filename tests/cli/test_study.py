@@ -119,7 +119,7 @@ def test_jets_needs_a_folder_of_test_points(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(["study", "jets"]) == 2
     err = capsys.readouterr().err
-    assert err == ("pitotcal study: study jets needs `--data`, the folder of the CLASS*.csv "
+    assert err == ("pitotcal study: study jets needs --data, the folder of the CLASS*.csv "
                    "test points\n")
     assert main(["study", "jets", "--data", str(tmp_path)]) == 2
     assert "has no CLASS*.csv test point" in capsys.readouterr().err
