@@ -20,7 +20,7 @@ from pitotcal.core.models import qc_from_qci_pa
 from .residual import ratio_columns, residual, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
-__all__ = ["IV_WINDOW_S", "instruments", "iv_refine", "smooth_in_time"]
+__all__ = ["IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine", "smooth_in_time"]
 
 IV_WINDOW_S = 20.0
 
@@ -43,6 +43,21 @@ def instruments(model, theta, q_smooth, jac):
     return z
 
 
+def estimating_equations(model, theta, channels, q_smooth):
+    """(g, Z, S): the refined estimate's equations g(theta) = Z^T r + the wind rows' corrected
+    score (zero at the estimate), the instruments Z and the sensitivities S at `theta`."""
+    ch = channels
+    r = residual(model, theta, *ch.args)
+    s = sensitivities(model, theta, *ch.args)
+    z = instruments(model, theta, q_smooth, s)
+    g = z.T @ r
+    # the wind rows: the gradient of the objective's GPS-noise spread term
+    c, w = spread_weights(model, theta, ch)
+    g[WIND_N] += c * float(np.sum(w * (ch.vn - theta[WIND_N])))
+    g[WIND_E] += c * float(np.sum(w * (ch.ve - theta[WIND_E])))
+    return g, z, s
+
+
 def iv_refine(model, theta, channels, q_smooth, max_iter=10):
     """Solve Z^T r(theta) = corrected-score terms by Newton steps from the output-error optimum.
 
@@ -63,14 +78,7 @@ def iv_refine(model, theta, channels, q_smooth, max_iter=10):
     scales = theta_scales(model)
     th = np.asarray(theta, dtype=float).copy()
     for _ in range(max_iter):
-        r = residual(model, th, *ch.args)
-        s = sensitivities(model, th, *ch.args)
-        z = instruments(model, th, q_smooth, s)
-        g = z.T @ r
-        # the wind rows: the gradient of the objective's GPS-noise spread term
-        c, w = spread_weights(model, th, ch)
-        g[WIND_N] += c * float(np.sum(w * (ch.vn - th[WIND_N])))
-        g[WIND_E] += c * float(np.sum(w * (ch.ve - th[WIND_E])))
+        g, z, s = estimating_equations(model, th, ch, q_smooth)
         try:
             step = np.linalg.solve(z.T @ s, g)
         except np.linalg.LinAlgError:
