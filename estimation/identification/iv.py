@@ -20,17 +20,27 @@ from pitotcal.core.models import qc_from_qci_pa
 from .residual import ratio_columns, residual, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
-__all__ = ["IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine", "smooth_in_time"]
+__all__ = ["IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine", "smooth_in_time",
+           "window_bounds"]
 
 IV_WINDOW_S = 20.0
 
 
-def smooth_in_time(x, time_s, window_s):
-    """Centred moving average over `window_s` seconds (truncated at the ends; gaps allowed)."""
+def smooth_in_time(x, time_s, window_s, bounds=None):
+    """Centred moving average over `window_s` seconds (truncated at the ends; gaps allowed).
+
+    `bounds`: `window_bounds(time_s, window_s)` when already known (they depend on the times
+    alone: the budget smooths many perturbed copies of one record).
+    """
     c = np.concatenate([[0.0], np.cumsum(x)])
-    lo = np.searchsorted(time_s, time_s - 0.5 * window_s, side="left")
-    hi = np.searchsorted(time_s, time_s + 0.5 * window_s, side="right")
+    lo, hi = window_bounds(time_s, window_s) if bounds is None else bounds
     return (c[hi] - c[lo]) / (hi - lo)
+
+
+def window_bounds(time_s, window_s):
+    """(lo, hi): the first and one past the last sample of each sample's centred window."""
+    return (np.searchsorted(time_s, time_s - 0.5 * window_s, side="left"),
+            np.searchsorted(time_s, time_s + 0.5 * window_s, side="right"))
 
 
 def instruments(model, theta, q_smooth, jac):
