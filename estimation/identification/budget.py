@@ -311,12 +311,13 @@ def _products_budget(result, budget, solved):
 
 
 def _static_products(result, vi):
-    """{"dh_ft", "dmach"} of a compressible result at the speeds `vi`; {} otherwise."""
-    from .static_source import static_source_products
+    """{"dh_ft", "dmach"} of a compressible result at the speeds `vi`; {} otherwise (values
+    only: a perturbed calibration's bands are not used)."""
+    from .static_source import static_source_values
 
     if result.air_data != "compressible" or result.ps_pa is None:
         return {}
-    grid = static_source_products(result, vi)
+    grid = static_source_values(result, vi)
     return {key: np.asarray(grid[key], dtype=float) for key in ("dh_ft", "dmach")}
 
 
