@@ -5,7 +5,7 @@ Run: ``python benchmarks/bench_budget.py [--repeats 5] [--sizes 4000 16000 10000
 [--no-resolve-above N]``. For each N, a synthetic flight (5 Hz held GPS with a vertical
 channel, 0.05 m/s GPS noise, 0.5 Pa pressure noise, light turbulence): the median time of
 `identify` (the baseline, its solver cached) and of `uncertainty_budget` with the default inputs
-and a 1 m probe arm, by sensitivities (the default: one factorisation, no solve) and by
+and a 1 m probe arm, by sensitivities (the default: no solve) and by
 re-solves (`method="resolve"`: 14 solves), measured alternating in the same run, and the
 largest relative difference of any term at any speed. Then the whole `pitotcal identify`
 command on a 16,000-sample flight: the budget by sensitivities, by re-solves and

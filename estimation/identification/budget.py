@@ -10,9 +10,9 @@ noise, and at each table speed
 
     u_j(V_i) = sqrt((d₊² + d₋²) / 2),   d± = ΔV(V_i; x_j ± u) − ΔV(V_i; x_j)
 
-The estimates on the perturbed flights come from the fit's sensitivities (`linearised`: one
-factorisation of the fitted problem, then one evaluation of its estimating equations per
-perturbed flight, Δθ = −J⁻¹ Δg; method "sensitivity", the default) or from re-solving
+The estimates on the perturbed flights come from the fit's sensitivities (`linearised`: the
+Jacobian J of the fit's estimating equations g formed once, then a few evaluations of g per
+perturbed flight, Δθ = −J⁻¹ Δg repeated to the root; method "sensitivity", the default) or from re-solving
 `estimate` on each (method "resolve"). A term whose linearised steps do not converge
 (`linearised.CONTRACTION`) is re-solved, with a note; the tests check that both agree.
 
@@ -184,8 +184,8 @@ def uncertainty_budget(flight, result, inputs=None, *, method="sensitivity", **i
     Notes
     -----
     Two perturbed estimates per source with a nonzero uncertainty (the GPS bias only with a
-    vertical channel). By sensitivities each costs two O(N) evaluations of the estimating
-    equations after one factorisation; a re-solve is `identification.estimate`, identify's
+    vertical channel). By sensitivities each costs two or three O(N) evaluations of the
+    estimating equations (`linearised`); a re-solve is `identification.estimate`, identify's
     estimate without the bounds and consistency checks the budget does not use, at most 16
     (benchmarks/bench_budget.py measures both). A compressible result's ΔH_pc and ΔM_pc get
     their budget from the same perturbed estimates (`Budget.products`).

@@ -13,7 +13,7 @@ perturbation that is not linear in its step, the GPS latency, keeps its second-o
 and the same estimator is linearised: the fitted samples (the gates and the outlier trimming
 of the fit, not done again), the GPS noise it used, its air data and its instruments.
 
-J is factorised once per result. The first-order step is then repeated with the same J
+J is formed once per result (p + 1 evaluations of g). The first-order step is then repeated with the same J
 (chord steps, each one O(N) evaluation of g) until it is below `REL_TOL` of the first (or
 `STEP_TOL`), so the estimate is the perturbed equations' root, the re-solve's, to a fraction
 of a percent of its change, and not only its first-order part: where the
@@ -28,7 +28,6 @@ error J has, so J is a forward difference (its error changes how fast, not where
 import dataclasses
 
 import numpy as np
-import scipy.linalg
 
 from pitotcal.core.measurement import flight_channels
 from pitotcal.core.models import get_model
@@ -98,7 +97,9 @@ class Linearised:
         ch = flight_channels(kept, result.gps_noise_std_mps, self.air_data, held=self.held)
         self.q_smooth = smooth_in_time(ch.qci, kept.time_s, IV_WINDOW_S, self.bounds)
         self.g0 = self._g(self.theta, ch, self.q_smooth)
-        self.lu = scipy.linalg.lu_factor(self._jacobian(ch, self.q_smooth))
+        # p x p (p <= 5): solved at each step, no factorisation to keep (and no scipy.linalg
+        # import, 0.4 s, in every command that imports the budget)
+        self.jacobian = self._jacobian(ch, self.q_smooth)
 
     def _kept(self, flight):
         """The fitted samples of `flight` (itself when the fit kept every sample)."""
@@ -135,7 +136,7 @@ class Linearised:
 
     def _step(self, theta, ch, q_smooth):
         """−J⁻¹ [g(θ; perturbed) − g(θ̂; unperturbed)]."""
-        return -scipy.linalg.lu_solve(self.lu, self._g(theta, ch, q_smooth) - self.g0)
+        return -np.linalg.solve(self.jacobian, self._g(theta, ch, q_smooth) - self.g0)
 
     def solve(self, perturbed):
         """`result` with the estimate θ̂ + Δθ of the `perturbed` flight (same samples).
