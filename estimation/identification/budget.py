@@ -12,8 +12,8 @@ noise, and at each table speed
 
 The estimates on the perturbed flights come from the fit's sensitivities (`linearised`: the
 Jacobian J of the fit's estimating equations g formed once, then a few evaluations of g per
-perturbed flight, Δθ = −J⁻¹ Δg repeated to the root; method "sensitivity", the default) or from re-solving
-`estimate` on each (method "resolve"). A term whose linearised steps do not converge
+perturbed flight, Δθ = −J⁻¹ Δg repeated to the root; method "sensitivity", the default) or
+from re-solving `estimate` on each (method "resolve"). A term whose linearised steps do not converge
 (`linearised.CONTRACTION`) is re-solved, with a note; the tests check that both agree.
 
 For an effect linear in x_j this is |∂ΔV/∂x_j| u, the GUM's first-order term; when the effect
@@ -69,8 +69,8 @@ from pitotcal.core.units import (
 from .linearised import Linearised, NotLinear
 from .sensor_inputs import RH_U_GIVEN_PCT, RH_U_UNKNOWN_PCT, BudgetInputs, resolve
 
-__all__ = ["COVERAGE_K", "METHODS", "RH_U_GIVEN_PCT", "RH_U_UNKNOWN_PCT", "SOURCES", "Budget", "BudgetInputs",
-           "uncertainty_budget"]
+__all__ = ["COVERAGE_K", "METHODS", "RH_U_GIVEN_PCT", "RH_U_UNKNOWN_PCT", "SOURCES", "Budget",
+           "BudgetInputs", "uncertainty_budget"]
 
 COVERAGE_K = 2.0
 # How the perturbed estimates are found: the fit's sensitivities, or re-solves

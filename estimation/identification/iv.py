@@ -20,10 +20,12 @@ from pitotcal.core.models import qc_from_qci_pa
 from .residual import ratio_columns, residual, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
-__all__ = ["IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine", "smooth_in_time",
-           "window_bounds"]
+__all__ = ["IV_NOT_CONVERGED", "IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine",
+           "smooth_in_time", "window_bounds"]
 
 IV_WINDOW_S = 20.0
+# The start of the warning a result carries when the refinement did not converge
+IV_NOT_CONVERGED = "instrumental-variable refinement did not converge"
 
 
 def smooth_in_time(x, time_s, window_s, bounds=None):

@@ -1,4 +1,4 @@
-"""The fit's estimate on slightly perturbed data, to first order, without solving again.
+"""The fit's estimate on slightly perturbed data from its sensitivities, without solving again.
 
 The reported estimate θ̂ is the root of the refined estimating equations g(θ; data) = 0
 (`iv.estimating_equations`: the instrumental-variable rows of the coefficients and the
@@ -13,10 +13,10 @@ perturbation that is not linear in its step, the GPS latency, keeps its second-o
 and the same estimator is linearised: the fitted samples (the gates and the outlier trimming
 of the fit, not done again), the GPS noise it used, its air data and its instruments.
 
-J is formed once per result (p + 1 evaluations of g). The first-order step is then repeated with the same J
-(chord steps, each one O(N) evaluation of g) until it is below `REL_TOL` of the first (or
-`STEP_TOL`), so the estimate is the perturbed equations' root, the re-solve's, to a fraction
-of a percent of its change, and not only its first-order part: where the
+J is formed once per result (p + 1 evaluations of g). The first-order step is then repeated
+with the same J (chord steps, each one O(N) evaluation of g) until it is below `REL_TOL` of
+the first (or `STEP_TOL`), so the estimate is the perturbed equations' root, the re-solve's,
+to a fraction of a percent of its change, and not only its first-order part: where the
 coefficients are strongly correlated (k1 and k2 at 0.99+) the change of J with the data
 turns a 0.2 % transducer scale into a 6 % second step in k1/k2 (measured on the tests'
 flight), then 0.02 % in the third; a 1 % scale takes 7 steps, each below 0.6 of the one
@@ -29,12 +29,17 @@ import dataclasses
 
 import numpy as np
 
+from pitotcal.core.gps_velocity import interpolate_held
 from pitotcal.core.measurement import flight_channels
 from pitotcal.core.models import get_model
 
-from pitotcal.core.gps_velocity import interpolate_held
-
-from .iv import IV_WINDOW_S, estimating_equations, smooth_in_time, window_bounds
+from .iv import (
+    IV_NOT_CONVERGED,
+    IV_WINDOW_S,
+    estimating_equations,
+    smooth_in_time,
+    window_bounds,
+)
 from .unknowns import theta_scales, to_reported
 
 __all__ = ["CONTRACTION", "MAX_STEPS", "REL_TOL", "STEP_TOL", "Linearised", "NotLinear"]
@@ -51,7 +56,6 @@ CONTRACTION = 0.9
 MAX_STEPS = 12
 # Step of the forward differences of g in the scaled unknowns (their coefficients O(1)).
 _FD_STEP = 1e-4
-_IV_NOT_CONVERGED = "instrumental-variable refinement did not converge"
 
 
 class NotLinear(Exception):
@@ -76,7 +80,7 @@ class Linearised:
     """
 
     def __init__(self, flight, result):
-        if not result.success or any(_IV_NOT_CONVERGED in w for w in result.warnings):
+        if not result.success or any(IV_NOT_CONVERGED in w for w in result.warnings):
             raise NotLinear("the estimate is not the root of the refined estimating equations")
         keep = np.isin(flight.time_s, result.time_s)
         if int(keep.sum()) != result.n_samples or not np.array_equal(flight.time_s[keep],
