@@ -218,7 +218,7 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved, method):
         (and a note naming the source) where a perturbation or its re-solve is refused or its
         ΔV does not exist."""
         try:
-            pair = _perturbed_pair(perturb, name, linear, kwargs, notes)
+            pair = _perturbed_pair(flight, perturb, name, linear, kwargs, notes)
         except PitotcalError as exc:
             notes.append(f"uncertainty budget: the {name} term is not computed: its "
                          f"perturbed re-solve was refused ({exc})")
@@ -242,11 +242,11 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved, method):
             # north and east: V_g + b - W = V_g - (W - b), the fit's wind takes b exactly
             # (the tests re-solve to show it); only the vertical channel is left
             terms[name] = (np.zeros_like(vi) if flight.gps_vd_mps is None else
-                           sensitivity(lambda s, u=u: gps_bias(flight, "gps_vd_mps", s * u),
+                           sensitivity(lambda f, s, u=u: gps_bias(f, "gps_vd_mps", s * u),
                                        name))
         else:
             perturb = PERTURBATIONS[name]
-            terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u), name)
+            terms[name] = sensitivity(lambda f, s, p=perturb, u=u: p(f, result, s * u), name)
     for note in notes:
         warnings.warn(note, stacklevel=2)
     return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,
@@ -264,18 +264,22 @@ def _linearised(flight, result, notes):
         return None
 
 
-def _perturbed_pair(perturb, name, linear, kwargs, notes):
-    """The estimates at +u and −u: linearised when `linear` is given and the linearisation is
-    good, else re-solved (a note says which term and why)."""
+def _perturbed_pair(flight, perturb, name, linear, kwargs, notes):
+    """The estimates at +u and −u (`perturb(flight, sign)`): linearised when `linear` is given
+    and the linearisation is good, else re-solved (a note says which term and why).
+
+    Linearised, the fitted samples are perturbed: a sample the gates dropped stays out (a GPS
+    spike shifted in time by the latency term is not let back in at its neighbour, where the
+    re-solve's gate finds and drops it again)."""
     from .fit import estimate
 
     if linear is not None:
         try:
-            return [linear.solve(perturb(sign)) for sign in (1.0, -1.0)]
+            return [linear.solve(perturb(linear.fitted, sign)) for sign in (1.0, -1.0)]
         except NotLinear as exc:
             notes.append(f"uncertainty budget: the {name} term is re-solved, not linearised: "
                          f"{exc}")
-    pair = [estimate(perturb(sign), **kwargs) for sign in (1.0, -1.0)]
+    pair = [estimate(perturb(flight, sign), **kwargs) for sign in (1.0, -1.0)]
     notes.extend(f"uncertainty budget: a perturbed re-solve did not converge ({res.message})"
                  for res in pair if not res.success)
     return pair

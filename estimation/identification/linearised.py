@@ -72,6 +72,11 @@ class Linearised:
         are found by their times).
     result : IdentificationResult
 
+    Attributes
+    ----------
+    fitted : pitotcal.core.flight.Flight
+        The samples `result` was fitted on; `solve` takes them perturbed.
+
     Raises
     ------
     NotLinear
@@ -87,15 +92,14 @@ class Linearised:
                                                                      result.time_s):
             raise NotLinear("the fitted samples are not found by their times")
         self.result = result
-        self.keep = keep
         self.model = get_model(result.model)
         self.air_data = ("incompressible" if result.air_data == "incompressible" else
                          "reference" if result.ps_ref_pa is not None else "compressible")
         self.theta = np.asarray(result.internal_params, dtype=float)
         self.scales = theta_scales(self.model)
-        # what depends on the times and the GPS alone, for perturbations that keep them
-        self.flight = flight
-        kept = self._kept(flight)
+        # the fitted samples, which `solve` takes perturbed; what depends on their times and
+        # GPS alone is kept for perturbations that keep those
+        self.fitted = kept = flight if keep.all() else flight.select(keep)
         self.bounds = window_bounds(kept.time_s, IV_WINDOW_S)
         self.held = interpolate_held(kept.time_s, *self._gps(kept))
         ch = flight_channels(kept, result.gps_noise_std_mps, self.air_data, held=self.held)
@@ -105,24 +109,18 @@ class Linearised:
         # import, 0.4 s, in every command that imports the budget)
         self.jacobian = self._jacobian(ch, self.q_smooth)
 
-    def _kept(self, flight):
-        """The fitted samples of `flight` (itself when the fit kept every sample)."""
-        return flight if self.keep.all() else flight.select(self.keep)
-
     @staticmethod
     def _gps(flight):
         return tuple(c for c in (flight.gps_vn_mps, flight.gps_ve_mps, flight.gps_vd_mps)
                      if c is not None)
 
-    def _channels(self, flight):
-        """(channels, smoothed q_ci) of the fitted samples of `flight` (unperturbed or not);
-        the GPS interpolation and the smoothing reused where the perturbation kept their
-        inputs (the same arrays)."""
-        kept = self._kept(flight)
-        same_gps = all(a is b for a, b in zip(self._gps(flight), self._gps(self.flight)))
+    def _channels(self, kept):
+        """(channels, smoothed q_ci) of `fitted` perturbed (`kept`); the GPS interpolation
+        and the smoothing reused where the perturbation kept their inputs (the same arrays)."""
+        same_gps = all(a is b for a, b in zip(self._gps(kept), self._gps(self.fitted)))
         ch = flight_channels(kept, self.result.gps_noise_std_mps, self.air_data,
                              held=self.held if same_gps else None)
-        if flight.qci_pa is self.flight.qci_pa:
+        if kept.qci_pa is self.fitted.qci_pa:
             return ch, self.q_smooth
         return ch, smooth_in_time(ch.qci, kept.time_s, IV_WINDOW_S, self.bounds)
 
@@ -143,13 +141,13 @@ class Linearised:
         return -np.linalg.solve(self.jacobian, self._g(theta, ch, q_smooth) - self.g0)
 
     def solve(self, perturbed):
-        """`result` with the estimate θ̂ + Δθ of the `perturbed` flight (same samples).
+        """`result` with the estimate θ̂ + Δθ of `perturbed`: `fitted` perturbed.
 
         Returns
         -------
         IdentificationResult
             `params` and `internal_params` moved; its data (q_ci, ρ, p_s) the perturbed
-            flight's fitted samples, as a re-solve's; no static-error fit of its own
+            samples', as a re-solve's; no static-error fit of its own
             (`static_source.fitted_static_error` fits it again, as for a re-solve).
 
         Raises
@@ -172,7 +170,7 @@ class Linearised:
         else:
             raise NotLinear(f"its linearised steps do not converge in {MAX_STEPS}")
         params, _ = to_reported(theta, self.result.internal_covariance)
-        kept = self._kept(perturbed)
+        kept = perturbed
         compressible = self.result.air_data != "incompressible"
         return dataclasses.replace(
             self.result, params=params, internal_params=theta, qci_pa=kept.qci_pa,
