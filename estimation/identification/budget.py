@@ -4,11 +4,17 @@
 
 σ_stat is the estimate's own standard deviation (the colored-residual covariance:
 `dv_2sigma_kt` / 2). Each Type B input x_j (a quantity the fit takes as exact) has a standard
-uncertainty u(x_j) with a documented default the user can override (`BudgetInputs`); its
-contribution is found by re-solving: the flight is perturbed to x_j ± u(x_j), `identify`
-re-solved on each with the same model and GPS noise, and at each table speed
+uncertainty u(x_j) with a documented default the user can override (`BudgetInputs`). The
+flight is perturbed to x_j ± u(x_j) and the estimate on each found with the same model and GPS
+noise, and at each table speed
 
     u_j(V_i) = sqrt((d₊² + d₋²) / 2),   d± = ΔV(V_i; x_j ± u) − ΔV(V_i; x_j)
+
+The estimates on the perturbed flights come from the fit's sensitivities (`linearised`: the
+Jacobian J of the fit's estimating equations g formed once, then a few evaluations of g per
+perturbed flight, Δθ = −J⁻¹ Δg repeated to the root; method "sensitivity", the default) or
+from re-solving `estimate` on each (method "resolve"). A term whose linearised steps do not converge
+(`linearised.CONTRACTION`) is re-solved, with a note; the tests check that both agree.
 
 For an effect linear in x_j this is |∂ΔV/∂x_j| u, the GUM's first-order term; when the effect
 is not linear (the GPS latency is partly quadratic: a misalignment either way degrades the
@@ -48,6 +54,7 @@ import warnings
 
 import numpy as np
 
+from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import delta_v_kt_where_defined, get_model
 from pitotcal.core.moist_air import moist_density_kgm3
@@ -59,12 +66,15 @@ from pitotcal.core.units import (
     wind_vector_mps,
 )
 
+from .linearised import Linearised, NotLinear
 from .sensor_inputs import RH_U_GIVEN_PCT, RH_U_UNKNOWN_PCT, BudgetInputs, resolve
 
-__all__ = ["COVERAGE_K", "RH_U_GIVEN_PCT", "RH_U_UNKNOWN_PCT", "SOURCES", "Budget", "BudgetInputs",
-           "uncertainty_budget"]
+__all__ = ["COVERAGE_K", "METHODS", "RH_U_GIVEN_PCT", "RH_U_UNKNOWN_PCT", "SOURCES", "Budget",
+           "BudgetInputs", "uncertainty_budget"]
 
 COVERAGE_K = 2.0
+# How the perturbed estimates are found: the fit's sensitivities, or re-solves
+METHODS = ("sensitivity", "resolve")
 # (source name in the JSON, BudgetInputs field of its standard uncertainty, unit)
 SOURCES = (
     ("oat", "u_oat_k", "K"),
@@ -147,8 +157,8 @@ class Budget:
         return rows
 
 
-def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
-    """The GUM budget of `result`'s airspeed correction, by re-solving perturbed flights.
+def uncertainty_budget(flight, result, inputs=None, *, method="sensitivity", **identify_kwargs):
+    """The GUM budget of `result`'s airspeed correction, from its estimate on perturbed flights.
 
     Parameters
     ----------
@@ -158,6 +168,10 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
     result : IdentificationResult
     inputs : BudgetInputs, optional
         Standard uncertainties of the Type B inputs; default `BudgetInputs()`.
+    method : {"sensitivity", "resolve"}
+        "sensitivity": each perturbed estimate from the fitted problem's sensitivities
+        (`linearised.Linearised`), a term re-solved only where the linearisation is not good;
+        "resolve": every perturbed estimate re-solved.
     **identify_kwargs
         Passed on to `identify` for every re-solve (e.g. `air=`); the model is `result.model`
         and the GPS noise `result.gps_noise_std_mps`, so only the perturbed input differs.
@@ -169,22 +183,22 @@ def uncertainty_budget(flight, result, inputs=None, **identify_kwargs):
 
     Notes
     -----
-    Costs two re-solves per source with a nonzero uncertainty (the GPS bias only with a
-    vertical channel): at most 16, each reusing `identify`'s cached solver
-    (benchmarks/bench_budget.py measures the cost). Each is `identification.estimate`:
-    identify's estimate without the bounds and consistency checks the budget does not use.
-    A compressible result's ΔH_pc and ΔM_pc get their budget from the same re-solves
-    (`Budget.products`).
+    Two perturbed estimates per source with a nonzero uncertainty (the GPS bias only with a
+    vertical channel). By sensitivities each costs two or three O(N) evaluations of the
+    estimating equations (`linearised`); a re-solve is `identification.estimate`, identify's
+    estimate without the bounds and consistency checks the budget does not use, at most 16
+    (benchmarks/bench_budget.py measures both). A compressible result's ΔH_pc and ΔM_pc get
+    their budget from the same perturbed estimates (`Budget.products`).
     """
-    solved = {}                         # source -> its two re-solves, for ΔH and ΔM
-    budget = _resolved_budget(flight, result, inputs, identify_kwargs, solved)
+    checks.choice("method", method, METHODS)
+    solved = {}                         # source -> its two perturbed estimates, for ΔH and ΔM
+    budget = _resolved_budget(flight, result, inputs, identify_kwargs, solved, method)
     return dataclasses.replace(budget, products=_products_budget(result, budget, solved))
 
 
-def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
-    """The airspeed budget of `uncertainty_budget`; each source's re-solves go to `solved`."""
-    from .fit import estimate
-
+def _resolved_budget(flight, result, inputs, identify_kwargs, solved, method):
+    """The airspeed budget of `uncertainty_budget`; each source's perturbed estimates go to
+    `solved`."""
     flight = _fitted_samples(flight, result)
     arm_m = (result.reading or {}).get("probe_arm_m")
     if arm_m and not (getattr(flight, "reading", None) or {}).get("probe_arm_m"):
@@ -197,24 +211,21 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
               "model": result.model}
     notes = []
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
+    linear = _linearised(flight, result, notes) if method == "sensitivity" else None
 
     def sensitivity(perturb, name):
-        """u at each speed: the RMS of the re-solves' changes at +u and -u; NaN (and a note
-        naming the source) where a re-solve is refused or its ΔV does not exist."""
-        dv = []
-        for sign in (1.0, -1.0):
-            try:
-                res = estimate(perturb(sign), **kwargs)
-            except PitotcalError as exc:
-                notes.append(f"uncertainty budget: the {name} term is not computed: its "
-                             f"perturbed re-solve was refused ({exc})")
-                return np.full_like(vi, np.nan)
-            if not res.success:
-                notes.append(f"uncertainty budget: a perturbed re-solve did not converge "
-                             f"({res.message})")
-            dv.append(delta_v_kt_where_defined(get_model(res.model), res.coefficients, vi,
-                                               res.air_data) - dv0)
-            solved.setdefault(name, []).append(res)
+        """u at each speed: the RMS of the perturbed estimates' changes at +u and -u; NaN
+        (and a note naming the source) where a perturbation or its re-solve is refused or its
+        ΔV does not exist."""
+        try:
+            pair = _perturbed_pair(flight, perturb, name, linear, kwargs, notes)
+        except PitotcalError as exc:
+            notes.append(f"uncertainty budget: the {name} term is not computed: its "
+                         f"perturbed re-solve was refused ({exc})")
+            return np.full_like(vi, np.nan)
+        dv = [delta_v_kt_where_defined(get_model(res.model), res.coefficients, vi,
+                                       res.air_data) - dv0 for res in pair]
+        solved[name] = pair
         u = np.sqrt((dv[0] ** 2 + dv[1] ** 2) / 2.0)
         if not np.all(np.isfinite(u)):
             notes.append(f"uncertainty budget: the {name} term is not computed at "
@@ -231,17 +242,47 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved):
             # north and east: V_g + b - W = V_g - (W - b), the fit's wind takes b exactly
             # (the tests re-solve to show it); only the vertical channel is left
             terms[name] = (np.zeros_like(vi) if flight.gps_vd_mps is None else
-                           sensitivity(lambda s, u=u: gps_bias(flight, "gps_vd_mps", s * u),
+                           sensitivity(lambda f, s, u=u: gps_bias(f, "gps_vd_mps", s * u),
                                        name))
         else:
             perturb = PERTURBATIONS[name]
-            terms[name] = sensitivity(lambda s, p=perturb, u=u: p(flight, result, s * u), name)
+            terms[name] = sensitivity(lambda f, s, p=perturb, u=u: p(f, result, s * u), name)
     for note in notes:
         warnings.warn(note, stacklevel=2)
     return Budget(vi_kt=vi, statistical_kt=stat, terms_kt=terms,
                   inputs={name: (abs(getattr(inputs, field)), unit)
                           for name, field, unit in SOURCES},
                   warnings=tuple(dict.fromkeys(notes)), input_list=tuple(input_list))
+
+
+def _linearised(flight, result, notes):
+    """`linearised.Linearised` of `result`, or None (and a note) when every term re-solves."""
+    try:
+        return Linearised(flight, result)
+    except NotLinear as exc:
+        notes.append(f"uncertainty budget: every term re-solved, not linearised: {exc}")
+        return None
+
+
+def _perturbed_pair(flight, perturb, name, linear, kwargs, notes):
+    """The estimates at +u and −u (`perturb(flight, sign)`): linearised when `linear` is given
+    and the linearisation is good, else re-solved (a note says which term and why).
+
+    Linearised, the fitted samples are perturbed: a sample the gates dropped stays out (a GPS
+    spike shifted in time by the latency term is not let back in at its neighbour, where the
+    re-solve's gate finds and drops it again)."""
+    from .fit import estimate
+
+    if linear is not None:
+        try:
+            return [linear.solve(perturb(linear.fitted, sign)) for sign in (1.0, -1.0)]
+        except NotLinear as exc:
+            notes.append(f"uncertainty budget: the {name} term is re-solved, not linearised: "
+                         f"{exc}")
+    pair = [estimate(perturb(flight, sign), **kwargs) for sign in (1.0, -1.0)]
+    notes.extend(f"uncertainty budget: a perturbed re-solve did not converge ({res.message})"
+                 for res in pair if not res.success)
+    return pair
 
 
 # static-source product -> the JSON row's keys of its U and of its terms
@@ -274,12 +315,13 @@ def _products_budget(result, budget, solved):
 
 
 def _static_products(result, vi):
-    """{"dh_ft", "dmach"} of a compressible result at the speeds `vi`; {} otherwise."""
-    from .static_source import static_source_products
+    """{"dh_ft", "dmach"} of a compressible result at the speeds `vi`; {} otherwise (values
+    only: a perturbed calibration's bands are not used)."""
+    from .static_source import static_source_values
 
     if result.air_data != "compressible" or result.ps_pa is None:
         return {}
-    grid = static_source_products(result, vi)
+    grid = static_source_values(result, vi)
     return {key: np.asarray(grid[key], dtype=float) for key in ("dh_ft", "dmach")}
 
 

@@ -66,7 +66,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     budget : BudgetInputs or True, optional
         Compute the GUM uncertainty budget of the airspeed correction
         (`estimation.identification.budget`) with these Type B inputs (True: the defaults);
-        it costs up to 16 re-solves. None (the default): no budget.
+        by the fit's sensitivities (`budget`: no solve unless a term is not linear, then up
+        to 16 re-solves). None (the default): no budget.
     probe_arm_m : float
         Lateral position of the pitot probe, m (right wing +), corrected in the data
         (`_fit_corrected`); the record's `reading` keeps it. Default 0.

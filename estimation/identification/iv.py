@@ -20,17 +20,29 @@ from pitotcal.core.models import qc_from_qci_pa
 from .residual import ratio_columns, residual, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
-__all__ = ["IV_WINDOW_S", "instruments", "iv_refine", "smooth_in_time"]
+__all__ = ["IV_NOT_CONVERGED", "IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine",
+           "smooth_in_time", "window_bounds"]
 
 IV_WINDOW_S = 20.0
+# The start of the warning a result carries when the refinement did not converge
+IV_NOT_CONVERGED = "instrumental-variable refinement did not converge"
 
 
-def smooth_in_time(x, time_s, window_s):
-    """Centred moving average over `window_s` seconds (truncated at the ends; gaps allowed)."""
+def smooth_in_time(x, time_s, window_s, bounds=None):
+    """Centred moving average over `window_s` seconds (truncated at the ends; gaps allowed).
+
+    `bounds`: `window_bounds(time_s, window_s)` when already known (they depend on the times
+    alone: the budget smooths many perturbed copies of one record).
+    """
     c = np.concatenate([[0.0], np.cumsum(x)])
-    lo = np.searchsorted(time_s, time_s - 0.5 * window_s, side="left")
-    hi = np.searchsorted(time_s, time_s + 0.5 * window_s, side="right")
+    lo, hi = window_bounds(time_s, window_s) if bounds is None else bounds
     return (c[hi] - c[lo]) / (hi - lo)
+
+
+def window_bounds(time_s, window_s):
+    """(lo, hi): the first and one past the last sample of each sample's centred window."""
+    return (np.searchsorted(time_s, time_s - 0.5 * window_s, side="left"),
+            np.searchsorted(time_s, time_s + 0.5 * window_s, side="right"))
 
 
 def instruments(model, theta, q_smooth, jac):
@@ -41,6 +53,21 @@ def instruments(model, theta, q_smooth, jac):
     for j, col in enumerate(ratio_columns(model, k, q_smooth)):
         z[:, j] = qc_smooth * col
     return z
+
+
+def estimating_equations(model, theta, channels, q_smooth):
+    """(g, Z, S): the refined estimate's equations g(theta) = Z^T r + the wind rows' corrected
+    score (zero at the estimate), the instruments Z and the sensitivities S at `theta`."""
+    ch = channels
+    r = residual(model, theta, *ch.args)
+    s = sensitivities(model, theta, *ch.args)
+    z = instruments(model, theta, q_smooth, s)
+    g = z.T @ r
+    # the wind rows: the gradient of the objective's GPS-noise spread term
+    c, w = spread_weights(model, theta, ch)
+    g[WIND_N] += c * float(np.sum(w * (ch.vn - theta[WIND_N])))
+    g[WIND_E] += c * float(np.sum(w * (ch.ve - theta[WIND_E])))
+    return g, z, s
 
 
 def iv_refine(model, theta, channels, q_smooth, max_iter=10):
@@ -63,14 +90,7 @@ def iv_refine(model, theta, channels, q_smooth, max_iter=10):
     scales = theta_scales(model)
     th = np.asarray(theta, dtype=float).copy()
     for _ in range(max_iter):
-        r = residual(model, th, *ch.args)
-        s = sensitivities(model, th, *ch.args)
-        z = instruments(model, th, q_smooth, s)
-        g = z.T @ r
-        # the wind rows: the gradient of the objective's GPS-noise spread term
-        c, w = spread_weights(model, th, ch)
-        g[WIND_N] += c * float(np.sum(w * (ch.vn - th[WIND_N])))
-        g[WIND_E] += c * float(np.sum(w * (ch.ve - th[WIND_E])))
+        g, z, s = estimating_equations(model, th, ch, q_smooth)
         try:
             step = np.linalg.solve(z.T @ s, g)
         except np.linalg.LinAlgError:

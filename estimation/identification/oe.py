@@ -22,7 +22,7 @@ from pitotcal.core.models import get_model
 from pitotcal.core.processes import solver_interrupts
 
 from ..uncertainty.covariance import ColoredCovariance, colored_covariance, plain_covariance
-from .iv import IV_WINDOW_S, iv_refine, smooth_in_time
+from .iv import IV_NOT_CONVERGED, IV_WINDOW_S, iv_refine, smooth_in_time
 from .residual import (
     flight_channels,
     ratio_columns,
@@ -264,7 +264,7 @@ def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None, colo
     q_smooth = smooth_in_time(ch.qci, time_s, IV_WINDOW_S)
     theta_iv, instruments, jac_iv = iv_refine(model, theta, ch, q_smooth)
     if instruments is None:
-        warn.append("instrumental-variable refinement did not converge; output-error estimate kept")
+        warn.append(f"{IV_NOT_CONVERGED}; output-error estimate kept")
     else:
         theta, jac = theta_iv, jac_iv
     residuals = residual(model, theta, *ch.args)

@@ -38,8 +38,8 @@ __all__ = ["ASSUMED_STATIC", "MEASURED_STATIC", "air_data_lines", "calibrated_ma
            "fitted_static_error",
            "plot_altimeter_correction",
            "plot_static_error", "pressure_altitude_ic_m", "static_error_fit",
-           "static_source_products", "static_statement", "static_table_lines",
-           "unavailable_warning"]
+           "static_source_products", "static_source_values", "static_statement",
+           "static_table_lines", "unavailable_warning"]
 
 ASSUMED_STATIC = ("all pressure error in the static source: total pressure exact, "
                   "dp_p = q_c - q_ci = p_s,ind - p_s")
@@ -109,6 +109,13 @@ def static_error_fit(result):
     covariance is the colored-residual one (`estimation.uncertainty.covariance`).
     """
     from ..uncertainty.covariance import colored_covariance
+
+    k_static, design, residuals = _static_least_squares(result)
+    return k_static, colored_covariance(design, residuals).covariance
+
+
+def _static_least_squares(result):
+    """(k_static, design, residuals) of `static_error_fit`'s least squares."""
     from .residual import ratio_columns
 
     model = get_model(result.model)
@@ -118,8 +125,19 @@ def static_error_fit(result):
     zero = np.zeros(len(model.params))
     design = np.column_stack(ratio_columns(model, zero, qci)) * qc[:, None]
     k_static = np.linalg.lstsq(design, dp - qc * model(zero, qci), rcond=None)[0]
-    residuals = dp - qc * model(k_static, qci)
-    return k_static, colored_covariance(design, residuals).covariance
+    return k_static, design, dp - qc * model(k_static, qci)
+
+
+def static_source_values(result, vi_kt):
+    """{"dh_ft", "dmach"} of a compressible result at V_ic = `vi_kt`, without their bands (and
+    so without the static-error fit's covariance): what a perturbed calibration needs."""
+    model = get_model(result.model)
+    kk = result.coefficients
+    if result.ps_ref_pa is not None:
+        fit = getattr(result, "static_fit", None)
+        kk = np.concatenate([kk, _static_least_squares(result)[0] if fit is None else fit[0]])
+    values = _products(model, kk, vi_kt, float(np.median(result.ps_pa)), len(model.params))
+    return {"dh_ft": m_to_ft(values[3]), "dmach": values[2]}
 
 
 def fitted_static_error(result):

@@ -105,11 +105,12 @@ def _add_budget_arguments(p):
     bud = p.add_argument_group(
         "uncertainty budget",
         "GUM budget of the airspeed correction: the statistical 2-sigma plus Type B inputs, "
-        "each given as a standard uncertainty and propagated by re-solving the perturbed "
-        "flight; reported as the expanded uncertainty U (k = 2). The defaults quoted are the "
+        "each given as a standard uncertainty and propagated through the fit's sensitivities "
+        "to the perturbed flight; reported as the expanded uncertainty U (k = 2). The defaults quoted are the "
         "flight-test class's; --sensor-class takes another class's (docs/interfaces.md)")
     bud.add_argument("--no-budget", action="store_true",
-                     help="skip the budget (up to {budget_solves} extra solves)")
+                     help="skip the budget (by the fit's sensitivities: no extra solve unless a "
+                          "term is not linear, then up to {budget_solves} extra solves)")
     bud.add_argument("--sensor-class", default=None, metavar="CLASS",
                      help="the sensors' class, whose defaults fill every input not given: "
                           "{sensor_classes} (default {default_class}, or the aircraft file's "

@@ -333,12 +333,13 @@ class Channels:
         return self.qci, self.vn, self.ve, self.air, self.vd2, self.c_eiv
 
 
-def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible"):
+def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible", held=None):
     """The `Channels` of `flight`; sigma_v estimated from the data when not given.
 
     The air data come from `flight_air`: "compressible" needs the flight's `ps_pa` and
     `oat_k`, "reference" its `ps_ref_pa` and `oat_k` (`estimation.identify` checks and
-    chooses).
+    chooses). `held`: (channels, noise factor) of `interpolate_held` on the flight's GPS
+    velocity when already known (a copy of a flight with other channels changed).
     """
     gps = (flight.gps_vn_mps, flight.gps_ve_mps)
     if flight.gps_vd_mps is not None:
@@ -347,7 +348,7 @@ def flight_channels(flight, gps_noise_std_mps=None, air_data="incompressible"):
         sigma_v = estimate_gps_noise_std(flight.time_s, *gps)
     else:
         sigma_v = float(gps_noise_std_mps)
-    vel, noise_factor = interpolate_held(flight.time_s, *gps)
+    vel, noise_factor = interpolate_held(flight.time_s, *gps) if held is None else held
     air = flight_air(flight, air_data)
     extra = {}
     if isinstance(air, TotalPressureAir):
