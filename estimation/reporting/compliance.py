@@ -256,11 +256,17 @@ def _verdict(error, u, limit):
 
 
 def _uncertainty(row, expanded_key, plain_key):
-    """(u, kind) of a row: its expanded U when it has one, else its statistical 2σ."""
-    if _finite(row.get(expanded_key)):
-        return row[expanded_key], "expanded"
-    if _finite(row.get(plain_key)):
-        return row[plain_key], "statistical"
+    """(u, kind) of a row: its expanded U when it has one, else its statistical 2σ.
+
+    A negative band is refused: |e| + U ≤ limit would let it pass an error above the limit.
+    """
+    for key, kind in ((expanded_key, "expanded"), (plain_key, "statistical")):
+        if _finite(row.get(key)):
+            if row[key] < 0:
+                raise PitotcalError(f"`result` airspeed_correction row at {row['vc_kt']:.1f} "
+                                    f"KCAS: {key} {row[key]:g} is negative (an uncertainty "
+                                    "is at least 0)", param="result")
+            return row[key], kind
     return None, None
 
 
