@@ -242,3 +242,12 @@ def test_a_negative_uncertainty_is_refused_not_passed(kwargs, key):
         kwargs["dv_kt"] = -1.0
     with pytest.raises(PitotcalError, match=f"`result`.*{key} -[0-9.]+ is negative"):
         assess(result_json(**kwargs))
+
+
+def test_a_large_altimeter_error_is_judged_not_refused():
+    """ΔH −2,500 ft at sea level lies below the ISA table's −2,000 ft: the reduction's laws
+    carry it (unchanged at sea level) and the row does not comply; the report is written."""
+    block = assess(result_json(dv_kt=-1.0, u_kt=0.5, dh_ft=-2500.0, dh_u_ft=3.0))
+    row = block["altimeter"]["rows"][0]
+    assert row["dh_ft"] == pytest.approx(-2500.0, abs=1e-6)
+    assert block["altimeter"]["verdict"] == "does not comply"
