@@ -143,6 +143,21 @@ def test_report_reads_the_flight_as_identify_recorded(tmp_path):
     assert "does not reproduce" in html.read_text()
 
 
+def test_report_refits_with_the_probe_lever_arm_identify_corrected(identified, tmp_path):
+    """identify --probe-arm-m corrects the data and records the arm (reading.probe_arm_m);
+    `report --flight` corrects it the same way, so its re-fit reproduces the result (it
+    re-fitted the uncorrected flight: k1 -0.0016 against the result's -0.0036 on a simulated
+    T-2 flight with a 1.5 m arm)."""
+    csv, _ = identified
+    result = tmp_path / "armed.json"
+    assert main(["identify", str(csv), "--probe-arm-m", "1.5", "--no-budget", "--json",
+                 str(result)]) == 0
+    assert json.loads(result.read_text())["reading"]["probe_arm_m"] == 1.5
+    html = tmp_path / "r.html"
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(html)]) == 0
+    assert "does not reproduce" not in html.read_text()
+
+
 def test_report_warnings_in_json_and_stderr(tmp_path, capsys):
     res, out_json = tmp_path / "res.json", tmp_path / "r.json"
     res.write_text(json.dumps(result_json(dv_kt=-1.0)))       # no dv_U_kt: no expanded U
