@@ -8,7 +8,8 @@ stated"); a known field that is not text, a number or a date; NaN or infinite nu
 anywhere; a negative or zero weight; a negative speed (a key whose name says it is one).
 
 The rule's speeds, KCAS, in [aircraft]: vs0_kcas, vs1_kcas (Part 23), vsr0_kcas, vsr1_kcas
-(Part 25), vfe_kcas, vmo_kcas, vne_kcas; they must be positive numbers. With
+(Part 25), vfe_kcas, vmo_kcas, vne_kcas; they must be positive numbers, each stall speed
+below each limit speed (V_S0 at most V_S1, V_SR0 at most V_SR1). With
 `configuration` one of cruise, takeoff, approach, landing they set the compliance verdict's
 speed ranges (`aircraft_rule`); any other configuration text is shown and the airspeed check
 keeps the flown range, except a misspelling of one of those words, which is refused.
@@ -80,8 +81,9 @@ def aircraft_rule(path):
     Raises
     ------
     PitotcalError
-        As `read_aircraft`; and a speed that is not a positive number, or a configuration that
-        misspells one of the known ones, naming the key.
+        As `read_aircraft`; and a speed that is not a positive number, a stall speed not below
+        a limit speed (or V_S0 above V_S1, V_SR0 above V_SR1), or a configuration that
+        misspells one of the known ones, naming the keys.
     """
     doc = _load(path)
     _check(doc, path)
@@ -95,6 +97,7 @@ def aircraft_rule(path):
             raise PitotcalError(f"`aircraft_path` {path}: key aircraft.{key}: {value!r} is "
                                 "not a speed (a positive number of KCAS)")
         speeds[symbol] = float(value)
+    _check_speed_order(speeds, path)
     text = table.get("configuration")
     configuration = str(text).strip().lower() if text is not None else None
     if configuration not in CONFIGURATIONS:
@@ -106,6 +109,29 @@ def aircraft_rule(path):
                                 f"you mean {near[0]!r}?")
         configuration = None
     return {"configuration": configuration, "speeds_kcas": speeds}
+
+
+# A stall speed is below every limit speed, and the flaps-extended one at most the clean one:
+# otherwise the rule's speed range is empty or reversed (1.3 V_S1 above V_NE) and nothing the
+# verdict says could be trusted.
+_STALL = (("V_S0", "vs0_kcas"), ("V_S1", "vs1_kcas"), ("V_SR0", "vsr0_kcas"),
+          ("V_SR1", "vsr1_kcas"))
+_LIMIT = (("V_FE", "vfe_kcas"), ("V_MO", "vmo_kcas"), ("V_NE", "vne_kcas"))
+
+
+def _check_speed_order(speeds, path):
+    """Refuse stall and limit speeds in an impossible order, naming both keys."""
+    # (lower, higher, may they be equal)
+    pairs = [(a, b, False) for a in _STALL for b in _LIMIT]
+    pairs += [(_STALL[0], _STALL[1], True), (_STALL[2], _STALL[3], True)]
+    for (low, low_key), (high, high_key), equal in pairs:
+        if low not in speeds or high not in speeds:
+            continue
+        if speeds[low] > speeds[high] or (speeds[low] == speeds[high] and not equal):
+            rule = "at most" if equal else "below"
+            raise PitotcalError(
+                f"`aircraft_path` {path}: keys aircraft.{low_key} {speeds[low]:g} and "
+                f"aircraft.{high_key} {speeds[high]:g}: {low} must be {rule} {high}")
 
 
 def _load(path):

@@ -42,7 +42,9 @@ sensor's tube and pitot losses (``CAL_AIR_CMODEL`` with ``CAL_AIR_TUBELEN``,
 here is V_c relative to sqrt(2 Δp / ρ₀) of the logged Δp. When the log enables an SDP3x
 (``SENS_EN_SDP3X``) the recommendation warns and states what PX4's compensation adds at the
 median q_ci flown (models 0 and 1, the sensor's flow model; model 2's tube loss is not
-evaluated): the scale to load is about the one written divided by that factor.
+evaluated): the scale to load is about the one written divided by that factor. Not when q_ci
+was itself made of PX4's compensated IAS (the log reader's fallback, ``qc_source``
+``airspeed.indicated_airspeed_m_s ...``): the scale is then relative to that IAS already.
 """
 
 import warnings
@@ -231,6 +233,8 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
                                    qref, air, spread, departures, tuple(notes), misfit)
 
 
+# The flight's `qc_source` when the PX4 reader made q_ci of PX4's compensated IAS (½ ρ0 IAS²)
+_PX4_COMPENSATED_QC = "airspeed.indicated_airspeed_m_s"
 # PX4 CAL_AIR_CMODEL values whose SDP3x flow model `px4_sensor_note` evaluates
 _PX4_FLOW_MODELS = {0: "model with pitot", 1: "model without pitot"}
 
@@ -239,6 +243,9 @@ def px4_sensor_note(log_parameters, flight):
     """A warning (str) when the log's PX4 scales an IAS its SDP3x compensation has changed, else
     None (module docstring); the factor IAS_PX4 / sqrt(2 Δp/ρ₀) at the median q_ci flown."""
     if not log_parameters.get("SENS_EN_SDP3X"):
+        return None
+    if str(flight.meta.get("qc_source", "")).startswith(_PX4_COMPENSATED_QC):
+        # q_ci made of PX4's own IAS: the scale is already relative to the compensated IAS
         return None
     cmodel = int(log_parameters.get("CAL_AIR_CMODEL", 0))
     tube_m = float(log_parameters.get("CAL_AIR_TUBELEN", 0.2))

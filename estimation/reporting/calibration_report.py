@@ -309,8 +309,10 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     `flight_options` are the reading identify used: start_s, end_s, oat_k, temp_recovery,
     rh_pct (`pitotcal.io.read_flight`, which makes the air data); those not given (None) come
     from the result's `reading`. `configuration` (the configuration flown) overrides the
-    aircraft file's; the file's stall speeds set the verdict's speed ranges (`aircraft_rule`). The re-fit takes the result's model, air-data mode (`air_data`;
-    "incompressible" when it records none), GPS noise and stated GPS error (`gps_error`).
+    aircraft file's; the file's stall speeds set the verdict's speed ranges (`aircraft_rule`).
+    The re-fit takes the result's model, air-data mode (`air_data`; "incompressible" when it
+    records none), GPS noise, stated GPS error (`gps_error`) and the probe lever arm identify
+    corrected the data for (`reading.probe_arm_m`).
 
     Returns
     -------
@@ -335,7 +337,8 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
                          air=result.get("air_data", "incompressible"),
                          gps_noise_std_mps=result.get("gps_noise_std_mps"),
                          gps_error_sigma_mps=stated.get("sigma_mps"),
-                         gps_error_tau_s=stated.get("tau_s"))
+                         gps_error_tau_s=stated.get("tau_s"),
+                         probe_arm_m=(result.get("reading") or {}).get("probe_arm_m") or 0.0)
         inputs.append(("Flight", flight_path))
     rows, rule = (), {"configuration": None, "speeds_kcas": {}}
     if aircraft_path is not None:

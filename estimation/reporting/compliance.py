@@ -35,7 +35,7 @@ import math
 from pitotcal.core import airdata
 from pitotcal.core.checks import choice, number
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.units import ft_to_m, m_to_ft
+from pitotcal.core.units import ft_to_m, isa_altitude_m, isa_pressure_pa, m_to_ft
 
 from . import regulations as regs
 from .regulations import ALTIMETER_FT_PER_KT
@@ -99,8 +99,10 @@ def sea_level_dh_ft(dh_ft, pressure_altitude_ic_ft):
     notes); ft in, ft out.
     """
     h_ic = ft_to_m(pressure_altitude_ic_ft)
-    dp = airdata.static_pressure_pa(h_ic) - airdata.static_pressure_pa(h_ic + ft_to_m(dh_ft))
-    return float(m_to_ft(airdata.altimeter_correction_m(dp, 0.0)))
+    # the reduction's own altitudes (H_ic + ΔH, and the sea-level result) may lie beyond the
+    # ISA's tabulated range for a large ΔH: its laws, not a refusal, carry them there
+    dp = airdata.static_pressure_pa(h_ic) - isa_pressure_pa(h_ic + ft_to_m(dh_ft))
+    return float(m_to_ft(isa_altitude_m(airdata.P0_PA - dp)))
 
 
 def assess(result, regulation="23.1323", speed_range_kt=None, *, configuration=None,
@@ -256,11 +258,17 @@ def _verdict(error, u, limit):
 
 
 def _uncertainty(row, expanded_key, plain_key):
-    """(u, kind) of a row: its expanded U when it has one, else its statistical 2σ."""
-    if _finite(row.get(expanded_key)):
-        return row[expanded_key], "expanded"
-    if _finite(row.get(plain_key)):
-        return row[plain_key], "statistical"
+    """(u, kind) of a row: its expanded U when it has one, else its statistical 2σ.
+
+    A negative band is refused: |e| + U ≤ limit would let it pass an error above the limit.
+    """
+    for key, kind in ((expanded_key, "expanded"), (plain_key, "statistical")):
+        if _finite(row.get(key)):
+            if row[key] < 0:
+                raise PitotcalError(f"`result` airspeed_correction row at {row['vc_kt']:.1f} "
+                                    f"KCAS: {key} {row[key]:g} is negative (an uncertainty "
+                                    "is at least 0)", param="result")
+            return row[key], kind
     return None, None
 
 

@@ -65,6 +65,23 @@ def test_console_verdict_states_airspeed_and_altimeter(tmp_path, capsys):
     assert "airspeed complies, altimeter does not comply" in line
 
 
+def test_configuration_without_an_airspeed_range_is_said_not_a_traceback(tmp_path, capsys):
+    """25.1323(c) has no airspeed range for take-off flaps: the console line says so."""
+    res = tmp_path / "res.json"
+    res.write_text(json.dumps(result_json(dv_kt=-1.0, u_kt=0.5, dh_ft=20.0, dh_u_ft=3.0,
+                                          altitude_ft=5000.0)))
+    aircraft = tmp_path / "a.toml"
+    aircraft.write_text('[aircraft]\nvsr0_kcas = 60.0\nvsr1_kcas = 70.0\nvfe_kcas = 100.0\n'
+                        'vmo_kcas = 110.0\n')
+    args = ["report", str(res), "-o", str(tmp_path / "r.html"), "--aircraft", str(aircraft),
+            "--regulation", "25.1323", "--configuration", "takeoff"]
+    assert main(args) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("Compliance"))
+    assert line.startswith("Compliance (25.1323): not demonstrated, no speed range ")
+    # the altimeter window 1.23 V_SR0 = 73.8 KCAS to the flown top (1.7 V_SR1 = 119 beyond it)
+    assert "altimeter not demonstrated over 73.8-119.0 KCAS" in line
+
+
 @pytest.mark.parametrize("flag, what", [("--flight", "flight"),
                                         ("--aircraft", "aircraft file")])
 @pytest.mark.parametrize("out", ["-o", "--json", "--pdf"])
@@ -124,6 +141,21 @@ def test_report_reads_the_flight_as_identify_recorded(tmp_path):
     assert main(["report", str(result), "--flight", str(csv), "-o", str(html),
                  "--temp-recovery", "1.0"]) == 0
     assert "does not reproduce" in html.read_text()
+
+
+def test_report_refits_with_the_probe_lever_arm_identify_corrected(identified, tmp_path):
+    """identify --probe-arm-m corrects the data and records the arm (reading.probe_arm_m);
+    `report --flight` corrects it the same way, so its re-fit reproduces the result (it
+    re-fitted the uncorrected flight: k1 -0.0016 against the result's -0.0036 on a simulated
+    T-2 flight with a 1.5 m arm)."""
+    csv, _ = identified
+    result = tmp_path / "armed.json"
+    assert main(["identify", str(csv), "--probe-arm-m", "1.5", "--no-budget", "--json",
+                 str(result)]) == 0
+    assert json.loads(result.read_text())["reading"]["probe_arm_m"] == 1.5
+    html = tmp_path / "r.html"
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(html)]) == 0
+    assert "does not reproduce" not in html.read_text()
 
 
 def test_report_warnings_in_json_and_stderr(tmp_path, capsys):

@@ -87,7 +87,7 @@ def run(args):
     block = done["compliance"]
     if block.get("verdict"):
         print(f"Compliance ({args.regulation}): {block['verdict']}, "
-              f"{block['speed_range_kt'][0]:.1f}-{block['speed_range_kt'][1]:.1f} KCAS "
+              f"{_range(block['airspeed'])} "
               f"({block['speed_range_source']} range; {block['uncertainty']} uncertainty): "
               f"airspeed {block['airspeed']['verdict']}, "
               f"altimeter {block['altimeter']['verdict']} over {_range(block['altimeter'])}; "

@@ -108,3 +108,29 @@ def test_cli_configuration_choices_are_the_rules():
     from pitotcal.estimation.reporting import regulations
 
     assert CONFIGURATIONS == regulations.CONFIGURATIONS
+
+
+@pytest.mark.parametrize("speeds, match", [
+    # 1.3 V_S1 = 650 KCAS above V_NE 100: the window was reported as "650.0-100.0 KCAS"
+    ("vs1_kcas = 500\nvne_kcas = 100", r"aircraft.vs1_kcas 500 and aircraft.vne_kcas 100: V_S1 "
+                                       r"must be below V_NE"),
+    ("vs0_kcas = 60\nvs1_kcas = 50", r"aircraft.vs0_kcas 60 and aircraft.vs1_kcas 50: V_S0 must "
+                                     r"be at most V_S1"),
+    ("vsr1_kcas = 120\nvmo_kcas = 120", r"V_SR1 must be below V_MO"),
+    ("vsr0_kcas = 90\nvfe_kcas = 80", r"V_SR0 must be below V_FE"),
+])
+def test_speeds_in_an_impossible_order_are_refused(tmp_path, speeds, match):
+    from pitotcal.estimation.reporting.aircraft_file import aircraft_rule
+
+    path = tmp_path / "a.toml"
+    path.write_text(f"[aircraft]\n{speeds}\n")
+    with pytest.raises(PitotcalError, match=f"`aircraft_path` .*a.toml: keys .*{match}"):
+        aircraft_rule(path)
+
+
+def test_equal_stall_speeds_are_accepted(tmp_path):
+    from pitotcal.estimation.reporting.aircraft_file import aircraft_rule
+
+    path = tmp_path / "a.toml"
+    path.write_text("[aircraft]\nvs0_kcas = 50\nvs1_kcas = 50\nvfe_kcas = 90\n")
+    assert aircraft_rule(path)["speeds_kcas"] == {"V_S0": 50.0, "V_S1": 50.0, "V_FE": 90.0}

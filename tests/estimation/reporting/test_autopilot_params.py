@@ -107,6 +107,25 @@ def test_px4_sdp3x_compensation_is_warned_with_its_factor(constant_flight):
     assert not any("SDP3x" in n for n in plain.notes)
 
 
+def test_px4_q_ci_made_of_its_compensated_ias_is_not_compensated_again(constant_flight):
+    """A PX4 log whose q_ci the reader made of airspeed.indicated_airspeed_m_s (PX4's IAS,
+    its SDP3x compensation included): the scale is already relative to that IAS, so no
+    "divide by the factor" advice (it said divide by about 1.27: a scale 27 % low)."""
+    import dataclasses
+    import warnings
+
+    meta = {**constant_flight.meta, "qc_source": "airspeed.indicated_airspeed_m_s converted: "
+                                                 "q_ci = 0.5 rho0 IAS^2"}
+    flight = dataclasses.replace(constant_flight, meta=meta)
+    sdp3x = {"SENS_EN_SDP3X": 1, "CAL_AIR_CMODEL": 0, "CAL_AIR_TUBELEN": 0.2}
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*SDP3x.*")
+        rec = recommend(flight, "PX4", current=1.0, log_parameters=sdp3x)
+    assert not any("SDP3x" in n for n in rec.notes)
+    truth = 1.0 / np.sqrt(1.0 - K1)                 # V_c / V_i of the constant model
+    assert abs(rec.value - truth) <= rec.two_sigma
+
+
 def _true_misfit(model, k, const, misfit):
     """What the recommended single value costs against the true error over the same V_i range:
     the largest |ΔV_true − ΔV_constant fit| and the span of the true local ratio."""

@@ -228,3 +228,26 @@ def test_quotes_name_the_paragraphs_and_the_consensus_standard():
     assert {"14 CFR 23.1323(b)", "14 CFR 23.1325(e)", "14 CFR 29.1325(f)"} <= paragraphs
     assert any("need not be less than ±30 feet" in q["text"] for q in block["quotes"])
     assert "ASTM F3233" in block["basis"]
+
+
+@pytest.mark.parametrize("kwargs, key", [
+    ({"u_kt": -2.0}, "dv_U_kt"),
+    ({"band_kt": -2.0}, "dv_2sigma_kt"),
+    ({"u_kt": 0.5, "dh_ft": 80.0, "dh_u_ft": -30.0, "altitude_ft": 10000.0}, "dh_U_ft"),
+])
+def test_a_negative_uncertainty_is_refused_not_passed(kwargs, key):
+    # ΔV 6 kt against the 5 kt limit: |6| + (-2) <= 5 would have said "complies"
+    kwargs = {"dv_kt": 6.0, "band_kt": 0.3, **kwargs}
+    if "dh_ft" in kwargs:
+        kwargs["dv_kt"] = -1.0
+    with pytest.raises(PitotcalError, match=f"`result`.*{key} -[0-9.]+ is negative"):
+        assess(result_json(**kwargs))
+
+
+def test_a_large_altimeter_error_is_judged_not_refused():
+    """ΔH −2,500 ft at sea level lies below the ISA table's −2,000 ft: the reduction's laws
+    carry it (unchanged at sea level) and the row does not comply; the report is written."""
+    block = assess(result_json(dv_kt=-1.0, u_kt=0.5, dh_ft=-2500.0, dh_u_ft=3.0))
+    row = block["altimeter"]["rows"][0]
+    assert row["dh_ft"] == pytest.approx(-2500.0, abs=1e-6)
+    assert block["altimeter"]["verdict"] == "does not comply"
