@@ -161,8 +161,9 @@ def assess(result, regulation="23.1323", speed_range_kt=None, *, configuration=N
         "speed_range_source": air_window["source"],
         "flown_range_kcas": list(flown),
         "uncertainty": uncertainty, "uncertainty_note": _uncertainty_note(air, alt["rows"]),
-        # every row counts: an altimeter that does not comply is not hidden by the airspeed
-        "verdict": _worst(r["verdict"] for r in air + alt["rows"]),
+        # both checks count: an altimeter that does not comply, or that could not be judged
+        # (no static-source data), is not hidden by the airspeed
+        "verdict": _worst([_worst(r["verdict"] for r in air), alt["verdict"]]),
         "quotes": _quotes(regulation),
         "airspeed": {"verdict": _worst(r["verdict"] for r in air), "window": air_window,
                      "rows": air},

@@ -14,7 +14,7 @@ def _verdicts(block):
 def test_inside_complies_with_expanded_uncertainty():
     # |ΔV| + U = 1 + 2 = 3 kt < 5 kt at every speed (3 % of 99 KCAS is 2.97 kt: 5 kt governs)
     block = assess(result_json(dv_kt=-1.0, u_kt=2.0), "23.1323")
-    assert block["verdict"] == "complies" and _verdicts(block) == {"complies"}
+    assert block["airspeed"]["verdict"] == "complies" and _verdicts(block) == {"complies"}
     assert block["uncertainty"] == "expanded"
     assert block["speed_range_source"] == "flown"
     assert block["speed_range_kt"] == pytest.approx([69.0, 99.0])
@@ -25,7 +25,7 @@ def test_three_percent_governs_above_166_kt():
     block = assess(result_json(dv_kt=5.5, band_kt=0.2, vi_kt=(200.0, 250.0)), "25.1323")
     row = block["airspeed"]["rows"][-1]
     assert row["limit_kt"] == pytest.approx(0.03 * (250.0 + 5.5))
-    assert block["verdict"] == "complies"          # 5.7 kt < 3 % of 205.5 kt = 6.2 kt
+    assert block["airspeed"]["verdict"] == "complies"  # 5.7 kt < 3 % of 205.5 kt = 6.2 kt
 
 
 def test_outside_does_not_comply():
@@ -59,7 +59,7 @@ def test_range_beyond_flown_is_not_demonstrated_never_extrapolated():
 def test_range_inside_flown_interpolates_its_ends():
     res = result_json(dv_kt=lambda v: -0.1 * (v - 70.0), u_kt=0.5)
     block = assess(res, "23.1323", speed_range_kt=(72.0, 90.0))
-    assert block["verdict"] == "complies"
+    assert block["airspeed"]["verdict"] == "complies"
     judged = [r for r in block["airspeed"]["rows"] if r["verdict"] != "not judged"]
     first = judged[0]
     # vc = vi - 0.1 (vi - 70) = 72  ->  vi = 72.222, dv = -0.2222
@@ -251,3 +251,12 @@ def test_a_large_altimeter_error_is_judged_not_refused():
     row = block["altimeter"]["rows"][0]
     assert row["dh_ft"] == pytest.approx(-2500.0, abs=1e-6)
     assert block["altimeter"]["verdict"] == "does not comply"
+
+
+def test_an_altimeter_that_cannot_be_judged_keeps_the_headline_from_complying():
+    """No static-source data: the airspeed complies, the altimeter is not demonstrated, and so
+    is the whole verdict (a certification reader must not see "complies" for half a check)."""
+    block = assess(result_json(dv_kt=-1.0, u_kt=2.0), "23.1323")
+    assert block["airspeed"]["verdict"] == "complies"
+    assert block["altimeter"]["verdict"] == "not demonstrated" and block["altimeter"]["rows"] == []
+    assert block["verdict"] == "not demonstrated"
