@@ -46,6 +46,9 @@ _FIELD_TYPES = (str, int, float, datetime.date, datetime.time)
 # a key whose name ends so is a speed: never negative
 _SPEED_SUFFIXES = ("_kt", "_kts", "_kias", "_kcas", "_ktas", "_mps", "_kmh", "_kph", "_mph")
 _MISSPELT = 0.85        # difflib ratio from which an unknown name is a misspelt known one
+# the configurations are four known words, so a closer miss is still a misspelling ("crusie"
+# scores 0.83 against "cruise"); free text such as "flaps 10" stays far below
+_MISSPELT_CONFIGURATION = 0.75
 
 
 def read_aircraft(path):
@@ -102,7 +105,7 @@ def aircraft_rule(path):
     configuration = str(text).strip().lower() if text is not None else None
     if configuration not in CONFIGURATIONS:
         near = difflib.get_close_matches(configuration or "", CONFIGURATIONS, n=1,
-                                         cutoff=_MISSPELT)
+                                         cutoff=_MISSPELT_CONFIGURATION)
         if near:
             raise PitotcalError(f"`aircraft_path` {path}: key aircraft.configuration: "
                                 f"{text!r} is not one of {', '.join(CONFIGURATIONS)}; did "

@@ -76,6 +76,9 @@ def test_a_known_key_with_a_prefix_or_suffix_is_an_extra_key(tmp_path):
     ('[aircraft]\nconfiguration = "landng"\n',
      "key aircraft.configuration: 'landng' is not one of cruise, takeoff, approach, landing; "
      "did you mean 'landing'?"),
+    ('[aircraft]\nconfiguration = "crusie"\n',
+     "key aircraft.configuration: 'crusie' is not one of cruise, takeoff, approach, landing; "
+     "did you mean 'cruise'?"),
     ("[aircraft]\nvs0_kcas = 0\n", "key aircraft.vs0_kcas: 0 is not a speed"),
     ('[aircraft]\nvs1_kcas = "55"\n', "key aircraft.vs1_kcas: '55' is not a speed"),
     ("[aircraft]\nvs1_kcs = 55\n", "key aircraft.vs1_kcs: unknown; did you mean "
@@ -134,3 +137,10 @@ def test_equal_stall_speeds_are_accepted(tmp_path):
     path = tmp_path / "a.toml"
     path.write_text("[aircraft]\nvs0_kcas = 50\nvs1_kcas = 50\nvfe_kcas = 90\n")
     assert aircraft_rule(path)["speeds_kcas"] == {"V_S0": 50.0, "V_S1": 50.0, "V_FE": 90.0}
+
+
+def test_the_report_command_offers_the_configurations_the_verdict_knows():
+    from pitotcal.cli.report import CONFIGURATIONS as CLI_CONFIGURATIONS
+    from pitotcal.estimation.reporting.regulations import CONFIGURATIONS
+
+    assert CLI_CONFIGURATIONS == CONFIGURATIONS
