@@ -23,21 +23,15 @@ from pathlib import Path
 
 import numpy as np
 
+from pitotcal.studies.jets.study import TPS_EXPORT_MAP
+
 ROOT = Path(__file__).resolve().parents[1]
 SOURCE = "https://github.com/SaguaroAerospaceResearch/JMOSS"
 COMMIT = "8d5b162"
 FIXES = (("JMOSS/utilities.py", "mach[index] = sol\n", "mach[index] = sol[0]\n"),
          ("JMOSS/visualization.py", "cm.get_cmap('tab20').colors",
           "__import__('matplotlib').colormaps['tab20'].colors"))
-MAPPING = """\
-time              = { column = "time_s",          unit = "s" }
-gps_vn            = { column = "north_vel_fps",   unit = "ft/s" }
-gps_ve            = { column = "east_vel_fps",    unit = "ft/s" }
-gps_vd            = { column = "down_vel_fps",    unit = "ft/s" }
-total_pressure    = { column = "total_pres_psi",  unit = "psi" }
-static_pressure   = { column = "static_pres_psi", unit = "psi" }
-total_temperature = { column = "total_temp_K",    unit = "K" }
-gps_height        = { column = "height_ft",       unit = "ft" }
+MAPPING = TPS_EXPORT_MAP + """\
 roll              = { column = "roll_angle_rad",   unit = "rad" }
 pitch             = { column = "pitch_angle_rad",  unit = "rad" }
 true_heading      = { column = "true_heading_rad", unit = "rad" }

@@ -26,6 +26,7 @@ import dataclasses
 import numpy as np
 from scipy.optimize import least_squares
 
+from pitotcal.core import checks
 from pitotcal.core.airdata import (GAMMA, QC_OVER_PS_MAX, cas_from_qc_mps, mach_from_qc,
                                    pressure_altitude_m, qc_from_mach_pa)
 from pitotcal.core.errors import PitotcalError
@@ -136,7 +137,7 @@ def identify_mach(flight, *, knots=None, recovery_bounds=RECOVERY_BOUNDS):
     -------
     MachFitResult
     """
-    r_lo, r_hi = _recovery_bounds(recovery_bounds)
+    r_lo, r_hi = checks.recovery_bounds(recovery_bounds)
     data = _data(flight)
     knots = mach_knots(data["mach_ic"]) if knots is None else _knots(knots)
     data["basis"] = mach_spline_basis(data["mach_ic"], knots)
@@ -163,19 +164,6 @@ def identify_mach(flight, *, knots=None, recovery_bounds=RECOVERY_BOUNDS):
         sigma_q_pa=weights[0], sigma_t_k=weights[1], n_fit=int(data["mach_ic"].size),
         mach_ic_max=float(np.max(data["mach_ic"])))
     return dataclasses.replace(result, spe=_table(result, data))
-
-
-def _recovery_bounds(bounds):
-    """`recovery_bounds` checked: 0 < low <= high <= 1.5 (above 1 only to reproduce a peer)."""
-    try:
-        lo, hi = (float(b) for b in bounds)
-    except (TypeError, ValueError):
-        raise PitotcalError(f"`recovery_bounds` {bounds!r} must be two numbers (low, high)",
-                            param="recovery_bounds") from None
-    if not 0.0 < lo <= hi <= 1.5:
-        raise PitotcalError(f"`recovery_bounds` {bounds!r} must satisfy 0 < low <= high <= 1.5",
-                            param="recovery_bounds")
-    return lo, hi
 
 
 def _ram_line(data, r_lo, r_hi):

@@ -153,7 +153,7 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
     bin_width = checks.number("bin_width", bin_width, 1e-3, 0.5)
     height_drift_m = checks.number("height_drift_m", height_drift_m, 0.0, 100.0)
     oat_sigma_k = checks.number("oat_sigma_k", oat_sigma_k, 0.0, 50.0)
-    r_lo, r_hi = _recovery_bounds(recovery_bounds)
+    r_lo, r_hi = checks.recovery_bounds(recovery_bounds)
     data = _data(flight, attitude)
     fit = np.ones(data["ratio"].size, dtype=bool)
     profile = (data["oat0_k"], ISA_LAPSE_KPM)
@@ -184,19 +184,6 @@ def self_survey(flight, *, attitude=None, bin_width=0.025, height_drift_m=1.0,
         airspeed_model="vector" if "u" in data else "magnitude",
         wind_d_mps=float(x[4]) if x.size > 4 else 0.0,
         recovery_at_bound=bool(min(x[3] - r_lo, r_hi - x[3]) < 1e-6))
-
-
-def _recovery_bounds(bounds):
-    """`recovery_bounds` checked: 0 < low <= high <= 1.5 (above 1 only to reproduce a peer)."""
-    try:
-        lo, hi = (float(b) for b in bounds)
-    except (TypeError, ValueError):
-        raise PitotcalError(f"`recovery_bounds` {bounds!r} must be two numbers (low, high)",
-                            param="recovery_bounds") from None
-    if not 0.0 < lo <= hi <= 1.5:
-        raise PitotcalError(f"`recovery_bounds` {bounds!r} must satisfy 0 < low <= high <= 1.5",
-                            param="recovery_bounds")
-    return lo, hi
 
 
 def _data(flight, attitude=None):

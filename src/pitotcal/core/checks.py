@@ -11,8 +11,8 @@ import numpy as np
 
 from .errors import PitotcalError
 
-__all__ = ["choice", "exact", "integer", "number", "option_dict", "positive", "round_to_limit",
-           "wrap_deg"]
+__all__ = ["choice", "exact", "integer", "number", "option_dict", "positive", "recovery_bounds",
+           "round_to_limit", "wrap_deg"]
 
 
 def number(name, value, lo=-math.inf, hi=math.inf, *, lo_open=False, hi_open=False):
@@ -106,3 +106,17 @@ def with_overrides(cls, obj, overrides, *, name, caller):
         raise PitotcalError(f"{name} must be a {cls.__name__} or None, got "
                             f"{type(obj).__name__}", param=name)
     return dataclasses.replace(obj, **overrides) if overrides else obj
+
+
+def recovery_bounds(bounds, name="recovery_bounds"):
+    """(low, high) of a temperature probe's recovery factor, checked: 0 < low <= high <= 1.5
+    (above 1, which no probe has, only to reproduce a peer that allows it)."""
+    try:
+        lo, hi = (float(b) for b in bounds)
+    except (TypeError, ValueError):
+        raise PitotcalError(f"`{name}` {bounds!r} must be two numbers (low, high)",
+                            param=name) from None
+    if not 0.0 < lo <= hi <= 1.5:
+        raise PitotcalError(f"`{name}` {bounds!r} must satisfy 0 < low <= high <= 1.5",
+                            param=name)
+    return lo, hi
