@@ -8,8 +8,8 @@ Each size is a seeded synthetic flight (tests/synthetic.py: 50 Hz, 5 Hz held GPS
 noise, 0.5 Pa pressure noise, k = (0.02, -15 Pa), 5 m/s wind from 270 deg, 70-100 kt) written
 as a pitotcal CSV; the ArduPlane SITL log is added when the shared data holds it
 (PITOTCAL_SHARED_DATA, else ../shared/data). The three commands alternate in fresh processes
-(interleaved, so load changes hit all three alike); each child's wall time and peak RSS come
-from `os.wait4`. Medians of `--repeats` runs (`--repeats-large` above 200,000 samples). The
+(interleaved, so load changes hit all three alike); each child's wall time is timed here and its peak RSS
+comes from /usr/bin/time. Medians of `--repeats` runs (`--repeats-large` above 200,000 samples). The
 AirspeedFit core comes from $PITOTCAL_WEBTOOLS (a WebTools checkout), else the cache
 ~/.cache/pitotcal/webtools, filled from a local git mirror of ArduPilot/WebTools
 (/work/.mirror) or a shallow clone; without node or the core that column is skipped, saying why.
@@ -21,6 +21,7 @@ import cProfile  # noqa: F401  (the profile runs as `python -m cProfile` in a ch
 import json
 import os
 import pstats
+import resource
 import shutil
 import statistics
 import subprocess
@@ -102,17 +103,23 @@ def write_flights(sizes, tmp):
 
 
 def run_child(cmd):
-    """(wall s, peak RSS MB, stdout) of one child process."""
-    start = time.perf_counter()
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    out = proc.stdout.read()
-    err = proc.stderr.read()
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - start
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(map(str, cmd))} failed: {err.decode()[-500:]}")
-    return wall, usage.ru_maxrss / 1024.0, out.decode()
+    """(wall s, peak RSS MB, stdout) of one child process.
+
+    The peak comes from /usr/bin/time (GNU time's %M): the child is forked from that small
+    process, because a child forked from this one would report this process's RSS at the fork
+    as its own high-water mark. Without /usr/bin/time: RUSAGE_CHILDREN's, an upper bound."""
+    timer = shutil.which("time", path="/usr/bin:/bin")
+    with tempfile.NamedTemporaryFile("r", suffix=".rss") as rss:
+        full = [timer, "-q", "-f", "%M", "-o", rss.name, *cmd] if timer else cmd
+        start = time.perf_counter()
+        proc = subprocess.Popen(full, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        out, err = proc.communicate()
+        wall = time.perf_counter() - start
+        if proc.returncode != 0:
+            raise RuntimeError(f"{' '.join(map(str, cmd))} failed: {err.decode()[-500:]}")
+        kb = float(rss.read().split()[-1]) if timer else resource.getrusage(
+            resource.RUSAGE_CHILDREN).ru_maxrss
+    return wall, kb / 1024.0, out.decode()
 
 
 def speeds_kt(out_json):
@@ -181,7 +188,9 @@ def profile(csv, tmp, top=10):
         if file.startswith(str(ROOT)) and "/cli/" not in file and func != "<module>":
             rows.append((cum, f"{Path(file).relative_to(ROOT)}:{line} {func}"))
     total = max(cum for (_, _, _, cum, _) in stats.values())
-    return total, imports, sorted(rows, reverse=True)[:top]
+    own = sorted(((tt, f"{Path(file).name}:{line} {func}")
+                  for (file, line, func), (_, _, tt, _, _) in stats.items()), reverse=True)
+    return total, imports, sorted(rows, reverse=True)[:top], own[:top]
 
 
 def bench(flights, repeats, repeats_large, core, tmp):
@@ -231,10 +240,12 @@ def report(results, skipped, profiles, machine):
             dv = ", ".join(f"{x:+.3f}" for x in a["dv_kt"]) + f" (at {at} kt)"
             lines.append(f"| {label} | {name} | {dv} | {a['wind_mps']:.2f} from "
                          f"{a['wind_from_deg']:.1f} |")
-    for label, (total, imports, rows) in profiles.items():
-        lines += ["", f"identify profile, {label} (cProfile, {total:.2f} s in all, "
-                  f"imports {imports:.2f} s): top 10 by cumulative time", ""]
-        lines += [f"    {cum:7.3f} s  {name}" for cum, name in rows]
+    for label, (total, imports, rows, own) in profiles.items():
+        lines += ["", f"identify profile, {label} (cProfile, {total:.2f} s in all, of which "
+                  f"imports {imports:.2f} s, lazy ones inside functions included): the "
+                  "package's top 10 by cumulative time, then everything's top 10 by own time", ""]
+        lines += [f"    {cum:7.3f} s  {name}" for cum, name in rows] + [""]
+        lines += [f"    {tt:7.3f} s  {name}" for tt, name in own]
     return "\n".join(lines)
 
 
