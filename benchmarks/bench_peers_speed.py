@@ -17,8 +17,8 @@ Then one cProfile run of identify per size: its top 10 functions by cumulative t
 """
 
 import argparse
-import cProfile  # noqa: F401  (the profile runs as `python -m cProfile` in a child)
 import json
+import math
 import os
 import pstats
 import resource
@@ -158,7 +158,6 @@ def answers(name, stdout, out_json, speeds):
 
 
 def _from_deg(wn, we):
-    import math
     return math.degrees(math.atan2(-we, -wn)) % 360
 
 
@@ -216,18 +215,24 @@ def bench(flights, repeats, repeats_large, core, tmp):
     return results
 
 
+def _ratio(r, peer):
+    """The ratio of the medians, and the range of the runs' own ratios (each run's identify
+    and peer ran back to back)."""
+    pairs = [a / b for a, b in zip(r["all_wall_s"]["identify"], r["all_wall_s"][peer])]
+    return (f"{r['wall_s']['identify'] / r['wall_s'][peer]:.2f} "
+            f"({min(pairs):.2f}–{max(pairs):.2f})")
+
+
 def report(results, skipped, profiles, machine):
     lines = [f"Machine: {machine}", ""]
     names = ["identify", "scipy", "AirspeedFit"]
     lines.append("| flight | runs | identify s, MB | scipy script s, MB | AirspeedFit s, MB | "
-                 "identify / scipy | identify / AirspeedFit |")
+                 "identify / scipy (runs' range) | identify / AirspeedFit (runs' range) |")
     lines.append("|---|---:|---:|---:|---:|---:|---:|")
     for label, r in results.items():
         cells = [f"{r['wall_s'][k]:.2f}, {r['peak_mb'][k]:.0f}" if k in r["wall_s"] else "—"
                  for k in names]
-        ident = r["wall_s"]["identify"]
-        ratio = [f"{ident / r['wall_s'][k]:.2f}" if k in r["wall_s"] else "—"
-                 for k in names[1:]]
+        ratio = [_ratio(r, k) if k in r["wall_s"] else "—" for k in names[1:]]
         lines.append(f"| {label} | {r['runs']} | " + " | ".join(cells + ratio) + " |")
     if skipped:
         lines += ["", f"AirspeedFit skipped: {skipped}"]
@@ -253,7 +258,9 @@ def machine():
     cpu = next((line.split(":", 1)[1].strip() for line in
                 Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name")),
                "unknown CPU")
-    return f"{os.cpu_count()} cores ({cpu}), load {os.getloadavg()[0]:.1f}"
+    when = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    return (f"{when}, {len(os.sched_getaffinity(0))} cores (nproc; {cpu}), "
+            f"load {os.getloadavg()[0]:.1f}")
 
 
 def main(argv=None):

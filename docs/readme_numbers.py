@@ -328,6 +328,12 @@ PEERS_BENCH = ROOT / "benchmarks" / "bench_peers_speed.py"
 PEERS_SAVED = {}          # {"path": a saved --json of the benchmark}, set by --bench-from
 
 
+def _peer_ratio(r, peer):
+    pairs = [a / b for a, b in zip(r["all_wall_s"]["identify"], r["all_wall_s"][peer])]
+    return (f"{r['wall_s']['identify'] / r['wall_s'][peer]:.2f} "
+            f"({min(pairs):.2f}–{max(pairs):.2f})")
+
+
 def peers_speed(tmp):
     """benchmarks/bench_peers_speed.py: whole-process identify against the scipy script and
     AirspeedFit, medians of interleaved runs, with the machine they ran on."""
@@ -338,13 +344,13 @@ def peers_speed(tmp):
                        check=True, capture_output=True)
     run = json.loads(Path(saved).read_text())
     rows = ["| flight (samples) | runs | `pitotcal identify` | scipy script | AirspeedFit (node) "
-            "| identify / scipy | identify / AirspeedFit |", "|---|---:|---:|---:|---:|---:|---:|"]
+            "| identify / scipy (runs' range) | identify / AirspeedFit (runs' range) |",
+            "|---|---:|---:|---:|---:|---:|---:|"]
     for label, r in run["results"].items():
         wall, peak = r["wall_s"], r["peak_mb"]
         cell = [f"{wall[k]:.2f} s, {peak[k]:.0f} MB" if k in wall else "—"
                 for k in ("identify", "scipy", "AirspeedFit")]
-        ratio = [f"{wall['identify'] / wall[k]:.2f}" if k in wall else "—"
-                 for k in ("scipy", "AirspeedFit")]
+        ratio = [_peer_ratio(r, k) if k in wall else "—" for k in ("scipy", "AirspeedFit")]
         rows.append(f"| {label} | {r['runs']} | " + " | ".join(cell + ratio) + " |")
     note = (f"\nAirspeedFit skipped: {run['skipped']}\n" if run["skipped"] else "")
     return (f"\nWall time and peak memory of the whole process, medians of interleaved runs; "
