@@ -11,6 +11,9 @@ reader would, and writes what it printed between the markers::
     python docs/readme_numbers.py --timings   # also the wall-clock numbers (this machine)
     python docs/readme_numbers.py --tests     # also time the lean test suite (~90 s alone)
     python docs/readme_numbers.py --studies   # also the studies' tables (~1 min each)
+    python docs/readme_numbers.py --bench     # also the speed race against the peers (~5 min:
+                                              # benchmarks/bench_peers_speed.py)
+    python docs/readme_numbers.py --bench-from RUN.json   # the same from a saved run's --json
     python docs/readme_numbers.py --only legs-flight,studies-usage
 
 The real-log example reads the ArduPlane SITL log from $PITOTCAL_SHARED_DATA (else the nearest
@@ -321,6 +324,39 @@ def identify_time(tmp):
             f"{_machine()})")
 
 
+PEERS_BENCH = ROOT / "benchmarks" / "bench_peers_speed.py"
+PEERS_SAVED = {}          # {"path": a saved --json of the benchmark}, set by --bench-from
+
+
+def _peer_ratio(r, peer):
+    pairs = [a / b for a, b in zip(r["all_wall_s"]["identify"], r["all_wall_s"][peer])]
+    return (f"{r['wall_s']['identify'] / r['wall_s'][peer]:.2f} "
+            f"({min(pairs):.2f}–{max(pairs):.2f})")
+
+
+def peers_speed(tmp):
+    """benchmarks/bench_peers_speed.py: whole-process identify against the scipy script and
+    AirspeedFit, medians of interleaved runs, with the machine they ran on."""
+    saved = PEERS_SAVED.get("path")
+    if saved is None:
+        saved = tmp / "peers.json"
+        subprocess.run([sys.executable, str(PEERS_BENCH), "--no-profile", "--json", str(saved)],
+                       check=True, capture_output=True)
+    run = json.loads(Path(saved).read_text())
+    rows = ["| flight (samples) | runs | `pitotcal identify` | scipy script | AirspeedFit (node) "
+            "| identify / scipy (runs' range) | identify / AirspeedFit (runs' range) |",
+            "|---|---:|---:|---:|---:|---:|---:|"]
+    for label, r in run["results"].items():
+        wall, peak = r["wall_s"], r["peak_mb"]
+        cell = [f"{wall[k]:.2f} s, {peak[k]:.0f} MB" if k in wall else "—"
+                for k in ("identify", "scipy", "AirspeedFit")]
+        ratio = [_peer_ratio(r, k) if k in wall else "—" for k in ("scipy", "AirspeedFit")]
+        rows.append(f"| {label} | {r['runs']} | " + " | ".join(cell + ratio) + " |")
+    note = (f"\nAirspeedFit skipped: {run['skipped']}\n" if run["skipped"] else "")
+    return (f"\nWall time and peak memory of the whole process, medians of interleaved runs; "
+            f"{run['machine']}.\n\n" + "\n".join(rows) + "\n" + note)
+
+
 def tests_time(_):
     s = _wall([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"], ROOT, runs=1)
     return f"about {10 * round(s / 10):.0f} s on {_machine()}"
@@ -342,6 +378,7 @@ GENERATORS = {
     "demo-time": ("timings", demo_time),
     "identify-time": ("timings", identify_time),
     "tests-time": ("tests", tests_time),
+    "peers-speed": ("bench", peers_speed),
 }
 
 
@@ -392,10 +429,17 @@ def main(argv=None):
     p.add_argument("--tests", action="store_true", help="also time the lean test suite")
     p.add_argument("--studies", action="store_true",
                    help="also the studies' tables (seeded; a minute or more each)")
+    p.add_argument("--bench", action="store_true",
+                   help="also the speed race against the peers (benchmarks/bench_peers_speed.py)")
+    p.add_argument("--bench-from", default=None, metavar="RUN.json",
+                   help="the peers' speed block from a saved `bench_peers_speed.py --json` run")
     p.add_argument("--only", default=None, help="comma-separated block names")
     args = p.parse_args(argv)
+    if args.bench_from:
+        PEERS_SAVED["path"] = args.bench_from
     kinds = {"fixed", "data"} | ({"timings"} if args.timings else set()) \
-        | ({"tests"} if args.tests else set()) | ({"studies"} if args.studies else set())
+        | ({"tests"} if args.tests else set()) | ({"studies"} if args.studies else set()) \
+        | ({"bench"} if args.bench or args.bench_from else set())
     text = README.read_text(encoding="utf-8")
     present = blocks(text)
     names = [n for n in GENERATORS if n in present and GENERATORS[n][0] in kinds]
