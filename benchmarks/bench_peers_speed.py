@@ -43,8 +43,9 @@ def _cache():
     return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "pitotcal" / "webtools"
 
 
-def find_airspeedfit():
-    """(path of airspeedfit_core.js, None) or (None, why it is unavailable)."""
+def find_airspeedfit(fetch=True):
+    """(path of airspeedfit_core.js, None) or (None, why it is unavailable); without `fetch`
+    only a given, cached or mirrored copy is used, never a clone."""
     if shutil.which("node") is None:
         return None, "node is not installed"
     given = os.environ.get("PITOTCAL_WEBTOOLS")
@@ -62,6 +63,8 @@ def find_airspeedfit():
         if archive.returncode == 0:
             subprocess.run(["tar", "-x", "-C", str(cache)], input=archive.stdout, check=True)
             return cache / CORE, None
+    if not fetch:
+        return None, "not cached and --no-fetch given"
     try:
         clone = subprocess.run(["git", "clone", "-q", "--depth", "1", WEBTOOLS_URL,
                                 str(cache / "clone")], capture_output=True, timeout=120)
@@ -270,9 +273,11 @@ def main(argv=None):
     parser.add_argument("--repeats-large", type=int, default=3)
     parser.add_argument("--no-profile", action="store_true")
     parser.add_argument("--no-sitl", action="store_true", help="leave out the SITL log")
+    parser.add_argument("--no-fetch", action="store_true",
+                        help="use AirspeedFit only if cached or mirrored: never clone it")
     parser.add_argument("--json", default=None, help="also write the numbers to this file")
     args = parser.parse_args(argv)
-    core, skipped = find_airspeedfit()
+    core, skipped = find_airspeedfit(fetch=not args.no_fetch)
     load_before = machine()
     with tempfile.TemporaryDirectory() as tmp:
         flights = write_flights(args.sizes, tmp)

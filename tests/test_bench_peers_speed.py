@@ -15,7 +15,7 @@ BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_peers_speed.
 def run(tmp_path_factory):
     out = tmp_path_factory.mktemp("bench") / "peers.json"
     done = subprocess.run([sys.executable, str(BENCH), "--sizes", "2000", "--repeats", "1",
-                           "--no-profile", "--no-sitl", "--json", str(out)],
+                           "--no-profile", "--no-sitl", "--no-fetch", "--json", str(out)],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return json.loads(out.read_text()), done.stdout
