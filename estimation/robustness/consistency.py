@@ -245,14 +245,12 @@ def t_bound(tail, dof):
     leaves the noise model's variance uncertain, and z = coefficient / sigma then has the
     t's heavy tails, not the normal's (docs/measured.md).
     """
-    from scipy.stats import t as student_t
-
-    from pitotcal.core.information import student_t_widening
+    from pitotcal.core.information import student_t_isf, student_t_widening
 
     if not np.isfinite(dof):
         return float(normal_isf(tail))
     v = max(float(dof), 3.0)        # as the covariance's own widening takes it
-    return float(student_t.isf(tail, v)) / student_t_widening(v)
+    return student_t_isf(tail, v) / student_t_widening(v)
 
 
 def hidden_bound(n_onsets):
