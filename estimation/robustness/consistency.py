@@ -128,11 +128,9 @@ def _robust_std(x):
 
 def _running(x, width, median=False):
     """A running median or mean of `width` samples (centred, the ends held)."""
-    from scipy.ndimage import median_filter, uniform_filter1d
+    from .running import running_mean, running_median
 
-    if median:
-        return median_filter(x, size=width, mode="nearest")
-    return uniform_filter1d(x, size=width, mode="nearest")
+    return running_median(x, width) if median else running_mean(x, width)
 
 
 def _tail_drift(raw, width):
