@@ -243,7 +243,8 @@ def t_bound(tail, dof):
     leaves the noise model's variance uncertain, and z = coefficient / sigma then has the
     t's heavy tails, not the normal's (docs/measured.md).
     """
-    from pitotcal.core.information import student_t_isf, student_t_widening
+    from pitotcal.core.information import student_t_widening
+    from pitotcal.core.student_t import student_t_isf
 
     if not np.isfinite(dof):
         return float(normal_isf(tail))

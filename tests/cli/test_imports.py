@@ -12,7 +12,7 @@ from synthetic import synthetic_flight
 from pitotcal.io import write_flight_csv
 from pitotcal.io.plan_csv import write_plan
 
-HEAVY = ("scipy.ndimage", "scipy.stats", "scipy.signal", "control", "matplotlib", "jsbsim",
+HEAVY = ("scipy.ndimage", "scipy.stats", "scipy.special", "scipy.signal", "control", "matplotlib", "jsbsim",
          "dask")
 
 _PROBE = """

@@ -281,15 +281,6 @@ def normal_isf(p):
     return -NormalDist().inv_cdf(float(p))
 
 
-def student_t_isf(p, dof):
-    """t with P(T > t) = p for Student's t with `dof` degrees of freedom (scipy's t.isf, exact,
-    from scipy.special: importing scipy.stats costs ~1 s of every command that needs one
-    quantile)."""
-    from scipy.special import stdtrit
-
-    return -float(stdtrit(float(dof), float(p)))
-
-
 def student_t_widening(dof, z=2.0):
     """t_dof(Phi(z)) / z by the Cornish-Fisher expansion (within 1% of the exact value for
     dof >= 3); 1 for infinite dof. The estimator's widening too (`estimation.uncertainty.covariance`)."""
