@@ -80,13 +80,19 @@ def equation_values(model, theta, channels, q_smooth):
     qc_smooth = qc_from_qci_pa(model, k, q_smooth)
     g = np.empty(len(theta))
     for j, col in enumerate(ratio_columns(model, k, q_smooth)):
-        g[j] = (qc_smooth * col) @ r
+        g[j] = _dot(qc_smooth * col, r)
     ar = 2.0 * a * r                        # the wind columns of S are 2 a (V_g - wind)
     c, w = spread_weights(model, theta, ch)
     for row, v in ((WIND_N, ch.vn), (WIND_E, ch.ve)):
         dv = v - theta[row]
-        g[row] = dv @ ar + c * float(np.sum(w * dv))
+        g[row] = _dot(dv, ar) + c * _dot(w, dv)
     return g
+
+
+def _dot(x, y):
+    """Σ x y of two vectors by einsum, not BLAS: OpenBLAS's threaded dot costs ~10 ms per call
+    on a loaded machine at any length (measured), and g takes a few per evaluation."""
+    return float(np.einsum("i,i->", x, y))
 
 
 def iv_refine(model, theta, channels, q_smooth, max_iter=10):
