@@ -17,11 +17,11 @@ import numpy as np
 
 from pitotcal.core.models import qc_from_qci_pa
 
-from .residual import ratio_columns, residual, sensitivities, spread_weights
+from .residual import ratio_columns, residual, residual_terms, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
-__all__ = ["IV_NOT_CONVERGED", "IV_WINDOW_S", "estimating_equations", "instruments", "iv_refine",
-           "smooth_in_time", "window_bounds"]
+__all__ = ["IV_NOT_CONVERGED", "IV_WINDOW_S", "equation_values", "estimating_equations",
+           "instruments", "iv_refine", "smooth_in_time", "window_bounds"]
 
 IV_WINDOW_S = 20.0
 # The start of the warning a result carries when the refinement did not converge
@@ -68,6 +68,31 @@ def estimating_equations(model, theta, channels, q_smooth):
     g[WIND_N] += c * float(np.sum(w * (ch.vn - theta[WIND_N])))
     g[WIND_E] += c * float(np.sum(w * (ch.ve - theta[WIND_E])))
     return g, z, s
+
+
+def equation_values(model, theta, channels, q_smooth):
+    """g(theta) of `estimating_equations` alone, by one dot product per row: no N x p
+    instruments or sensitivities (the coefficient columns of S are not used by g; at N = 1e6
+    each matrix is 40 MB and most of g's time)."""
+    ch = channels
+    r, a, _ = residual_terms(model, theta, *ch.args)
+    k = np.asarray(theta[COEFS], dtype=float)
+    qc_smooth = qc_from_qci_pa(model, k, q_smooth)
+    g = np.empty(len(theta))
+    for j, col in enumerate(ratio_columns(model, k, q_smooth)):
+        g[j] = _dot(qc_smooth * col, r)
+    ar = 2.0 * a * r                        # the wind columns of S are 2 a (V_g - wind)
+    c, w = spread_weights(model, theta, ch)
+    for row, v in ((WIND_N, ch.vn), (WIND_E, ch.ve)):
+        dv = v - theta[row]
+        g[row] = _dot(dv, ar) + c * _dot(w, dv)
+    return g
+
+
+def _dot(x, y):
+    """Σ x y of two vectors by einsum, not BLAS: OpenBLAS's threaded dot costs ~10 ms per call
+    on a loaded machine at any length (measured), and g takes a few per evaluation."""
+    return float(np.einsum("i,i->", x, y))
 
 
 def iv_refine(model, theta, channels, q_smooth, max_iter=10):

@@ -36,7 +36,7 @@ from pitotcal.core.models import get_model
 from .iv import (
     IV_NOT_CONVERGED,
     IV_WINDOW_S,
-    estimating_equations,
+    equation_values,
     smooth_in_time,
     window_bounds,
 )
@@ -125,7 +125,7 @@ class Linearised:
         return ch, smooth_in_time(ch.qci, kept.time_s, IV_WINDOW_S, self.bounds)
 
     def _g(self, theta, ch, q_smooth):
-        return estimating_equations(self.model, theta, ch, q_smooth)[0]
+        return equation_values(self.model, theta, ch, q_smooth)
 
     def _jacobian(self, ch, q_smooth):
         """J = ∂g/∂θ at θ̂ by forward differences in the scaled unknowns."""

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from pitotcal.core.checks import number, positive
+from pitotcal.core.information import normal_isf
 
 from .ramp import RampTest, ramp_threshold
 
@@ -152,8 +153,6 @@ def cusum_threshold(arl_samples, kappa):
 def design(opts, block_s):
     """Thresholds for `opts` on blocks of `block_s`: {h: {stat: h}, kappa: {stat: κ},
     arl_hours_each, false_alarms_per_hour}."""
-    from scipy.stats import norm
-
     share = opts.false_alarms_per_hour * (1.0 - RAMP_SHARE) / (len(CUSUMS) + 2)
     arl_blocks = 3600.0 / block_s / share
     kappas = {"low": opts.kappa, "high": opts.kappa, "still": opts.kappa_band,
@@ -161,7 +160,7 @@ def design(opts, block_s):
     h = {s: cusum_threshold(arl_blocks, k) for s, k in kappas.items()}
     h["ramp"] = ramp_threshold(3600.0 / block_s / (opts.false_alarms_per_hour * RAMP_SHARE))
     return {"h": h,
-            "kappa": kappas, "jump_sigma": float(norm.isf(1.0 / arl_blocks)),
+            "kappa": kappas, "jump_sigma": float(normal_isf(1.0 / arl_blocks)),
             "arl_hours_each": 1.0 / share,
             "arl_hours_ramp": 1.0 / (opts.false_alarms_per_hour * RAMP_SHARE),
             "false_alarms_per_hour": opts.false_alarms_per_hour, "block_s": block_s}

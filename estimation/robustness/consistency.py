@@ -128,11 +128,9 @@ def _robust_std(x):
 
 def _running(x, width, median=False):
     """A running median or mean of `width` samples (centred, the ends held)."""
-    from scipy.ndimage import median_filter, uniform_filter1d
+    from .running import running_mean, running_median
 
-    if median:
-        return median_filter(x, size=width, mode="nearest")
-    return uniform_filter1d(x, size=width, mode="nearest")
+    return running_median(x, width) if median else running_mean(x, width)
 
 
 def _tail_drift(raw, width):
@@ -245,14 +243,13 @@ def t_bound(tail, dof):
     leaves the noise model's variance uncertain, and z = coefficient / sigma then has the
     t's heavy tails, not the normal's (docs/measured.md).
     """
-    from scipy.stats import t as student_t
-
     from pitotcal.core.information import student_t_widening
+    from pitotcal.core.student_t import student_t_isf
 
     if not np.isfinite(dof):
         return float(normal_isf(tail))
     v = max(float(dof), 3.0)        # as the covariance's own widening takes it
-    return float(student_t.isf(tail, v)) / student_t_widening(v)
+    return student_t_isf(tail, v) / student_t_widening(v)
 
 
 def hidden_bound(n_onsets):

@@ -99,7 +99,7 @@ def _qci_gate(flight, skip):
 
 def _gps_gate(flight, skip):
     """Samples whose ground velocity jumps off its running median faster than MAX_ACCEL_G."""
-    from scipy.ndimage import median_filter
+    from .running import running_median
 
     n = flight.n
     dt = float(np.median(np.diff(flight.time_s))) if n > 1 else 1.0
@@ -108,7 +108,7 @@ def _gps_gate(flight, skip):
     for v in (flight.gps_vn_mps, flight.gps_ve_mps, flight.gps_vd_mps):
         if v is None or v.shape != (n,) or not np.isfinite(v).all():
             continue
-        dev = np.abs(v - median_filter(v, size=width, mode="nearest"))
+        dev = np.abs(v - running_median(v, width))
         noise = 1.4826 * np.median(dev)
         off |= dev > MAX_ACCEL_G * G0_MPS2 * _ACCEL_WINDOW_S / 2 + 6.0 * noise
     return off & ~skip, (f"GPS velocity jumps of more than {MAX_ACCEL_G:g} g "
@@ -131,7 +131,7 @@ def outliers(residuals_pa):
     curved maneuver), and a sustained excursion is that noise, which the colored-residual
     covariance counts, not a glitch.
     """
-    from scipy.ndimage import median_filter
+    from .running import running_median
 
     r = np.asarray(residuals_pa, dtype=float)
     dev = np.abs(r - np.median(r))
@@ -139,7 +139,7 @@ def outliers(residuals_pa):
     if not scale > 0:
         return np.zeros(r.size, dtype=bool)
     threshold = trim_threshold(r.size) * scale
-    spike = np.abs(r - median_filter(r, size=_SPIKE_SAMPLES, mode="nearest"))
+    spike = np.abs(r - running_median(r, _SPIKE_SAMPLES))
     return (dev > threshold) & (spike > 0.5 * threshold)
 
 

@@ -48,16 +48,34 @@ def block_stats(time_s, qci_pa, block_s=BLOCK_S, t0=None):
     cuts = np.flatnonzero(np.diff(idx)) + 1
     starts = np.concatenate([[0], cuts])
     stops = np.concatenate([cuts, [t.size]])
+    means, band = _block_line_fits(t, q, starts, stops)
     keep = (stops - starts) >= _MIN_PER_BLOCK
     starts, stops = starts[keep], stops[keep]
-    means, band = np.empty(starts.size), np.empty(starts.size)
-    for j, (a, b) in enumerate(zip(starts, stops)):
-        tt, qq = t[a:b] - t[a], q[a:b]
-        coef = np.polyfit(tt, qq, 1)
-        resid = qq - np.polyval(coef, tt)
-        means[j] = qq.mean()
-        band[j] = resid @ resid / max(b - a - 2, 1) / max(means[j] ** 2, 1e-9)
+    means, band = means[keep], band[keep]
     return Blocks(starts, stops, t[stops - 1], means, band)
+
+
+def _block_line_fits(t, q, starts, stops):
+    """(mean, variance about the least-squares line over the mean squared) of `q` against `t`
+    in each block [start, stop) of a partition of the record: closed-form per-block least
+    squares on block-centred data, in O(N) vectorised sums rather than one fit per block."""
+    n = stops - starts
+    block_means = _block_means(q, starts, n)
+    tc = t - np.repeat(_block_means(t, starts, n), n)
+    qc = q - np.repeat(block_means, n)
+    sxx = np.add.reduceat(tc * tc, starts)
+    sxy = np.add.reduceat(tc * qc, starts)
+    slope = np.divide(sxy, sxx, out=np.zeros_like(sxy), where=sxx > 0)
+    resid = qc - np.repeat(slope, n) * tc
+    ss = np.add.reduceat(resid * resid, starts)
+    band = ss / np.maximum(n - 2, 1) / np.maximum(block_means ** 2, 1e-9)
+    return block_means, band
+
+
+def _block_means(x, starts, n):
+    """The mean of `x` over each block [starts, starts + n) (disjoint, increasing)."""
+    edges = np.column_stack([starts, starts + n]).ravel()
+    return np.add.reduceat(np.append(x, 0.0), edges)[::2] / n
 
 
 def block_residual_stats(result, block_s=BLOCK_S):
@@ -77,7 +95,7 @@ def block_residual_stats(result, block_s=BLOCK_S):
     qci = np.asarray(result.qci_pa, float)
     pred = qci - np.asarray(result.residuals_pa, float)
     blocks = block_stats(result.time_s, qci, block_s)
-    pred_b = np.array([pred[a:b].mean() for a, b in zip(blocks.start, blocks.stop)])
+    pred_b = _block_means(pred, blocks.start, blocks.stop - blocks.start)
     e = (blocks.qci_pa - pred_b) / pred_b
     if e.size < 10:
         raise PitotcalError(f"a noise model needs >= 10 blocks of {block_s:g} s, got {e.size}")

@@ -110,3 +110,19 @@ def test_ar1_times_is_the_dense_kernel_product():
         x = rng.normal(size=(700, 3))
         dense = np.exp(-np.abs(t[:, None] - t[None, :]) / tau) @ x
         np.testing.assert_allclose(ar1_times(t, tau, x), dense, rtol=1e-9, atol=1e-9)
+
+
+def test_quantiles_from_the_standard_library_are_scipy_stats_ones():
+    # the light quantile routes (no scipy.stats import) against scipy.stats itself
+    from scipy.stats import norm, t
+
+    from pitotcal.core.information import normal_isf
+    from pitotcal.core.student_t import student_t_isf
+
+    for p in (0.45, 0.25, 0.05, 0.025, 1e-3, 1e-6, 1e-10, 1e-12):
+        assert abs(normal_isf(p) / norm.isf(p) - 1) < 1e-12
+        for dof in (3.0, 3.5, 4.7, 7.0, 39.9, 40.0, 150.0, 1e3, 1e4, 1e5):
+            assert abs(student_t_isf(p, dof) / t.isf(p, dof) - 1) < 1e-12
+        for dof in (1.01e5, 1e6, 1e8):         # the Cornish-Fisher route
+            assert abs(student_t_isf(p, dof) / t.isf(p, dof) - 1) < 1e-12
+    assert abs(student_t_isf(0.75, 5.0) / t.isf(0.75, 5.0) - 1) < 1e-12     # the lower half

@@ -146,5 +146,10 @@ def _hermite_weights(t_fix, t):
 
 
 def _apply(weights, values):
+    """Σ_j w_j values[idx_j], one row at a time: no 4 × N gather and product at once (the
+    same additions in the same order as summing those rows)."""
     idx, w = weights
-    return np.sum(w * values[idx], axis=0)
+    out = w[0] * values[idx[0]]
+    for j in range(1, len(w)):
+        out += w[j] * values[idx[j]]
+    return out

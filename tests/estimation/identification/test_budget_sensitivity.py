@@ -140,3 +140,22 @@ def test_an_unknown_method_is_refused():
     flight = _synthetic()
     with pytest.raises(PitotcalError, match="method"):
         bd.uncertainty_budget(flight, identify(flight), INPUTS, method="newton")
+
+
+@pytest.mark.parametrize("kind, air", [("synthetic", "incompressible"),
+                                       ("synthetic", "compressible"),
+                                       ("reference", "compressible")])
+def test_equation_values_are_the_estimating_equations_g(kind, air):
+    """g by dot products (no N x p matrices) is the full equations' g, at the estimate and
+    off it (the budget's chord steps evaluate it there)."""
+    from pitotcal.estimation.identification import iv
+
+    flight = _reference() if kind == "reference" else _synthetic()
+    lin = linearised.Linearised(flight, identify(flight, air=air))
+    ch, q_smooth = lin._channels(lin.fitted)
+    off = lin.theta + 1e-3 * lin.scales
+    scale = np.abs(iv.estimating_equations(lin.model, off, ch, q_smooth)[0])   # g ~ 0 at θ̂
+    for theta in (lin.theta, off):
+        full = iv.estimating_equations(lin.model, theta, ch, q_smooth)[0]
+        fast = iv.equation_values(lin.model, theta, ch, q_smooth)
+        assert np.all(np.abs(fast - full) <= 1e-9 * scale)

@@ -160,3 +160,19 @@ def test_cli_json_names_the_trimmed_samples(clean, tmp_path):
         diff = (p["value"] - true + 180.0) % 360.0 - 180.0 if name == "wind_from_deg" \
             else p["value"] - true
         assert abs(diff) < 3 * p["std"], name
+
+
+def test_running_median_and_mean_are_scipy_ndimage_ones():
+    # numpy's route (short records) and scipy's (long ones) give the same running statistics
+    from scipy.ndimage import median_filter, uniform_filter1d
+
+    from pitotcal.estimation.robustness.running import running_mean, running_median
+
+    rng = np.random.default_rng(5)
+    for n, width in ((1, 1), (3, 4), (7, 10), (2_000, 2), (16_000, 25), (16_000, 250),
+                     (100_000, 251)):
+        x = 1.0 + 0.01 * rng.normal(size=n)
+        assert np.array_equal(running_median(x, width),
+                              median_filter(x, size=width, mode="nearest"))
+        assert np.allclose(running_mean(x, width), uniform_filter1d(x, size=width, mode="nearest"),
+                           rtol=1e-12, atol=0)
