@@ -126,3 +126,5 @@ def test_quantiles_from_the_standard_library_are_scipy_stats_ones():
         for dof in (1.01e5, 1e6, 1e8):         # the Cornish-Fisher route
             assert abs(student_t_isf(p, dof) / t.isf(p, dof) - 1) < 1e-12
     assert abs(student_t_isf(0.75, 5.0) / t.isf(0.75, 5.0) - 1) < 1e-12     # the lower half
+    for dof in (1.0, 3.0, 1e5, 2e5, 1e8):    # the median, on both routes
+        assert student_t_isf(0.5, dof) == t.isf(0.5, dof) == 0.0

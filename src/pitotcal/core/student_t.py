@@ -69,6 +69,8 @@ def student_t_isf(p, dof):
     p, v = float(p), float(dof)
     if not (0.0 < p < 1.0 and v > 0.0):
         raise PitotcalError(f"`p` must be in (0, 1) and `dof` > 0, got {p!r} and {v!r}")
+    if p == 0.5:                # the median: the widening below divides by z = 0
+        return 0.0
     if p > 0.5:
         return -student_t_isf(1.0 - p, v)
     z = normal_isf(p)
