@@ -2,7 +2,9 @@
 against the textbook formulas for white and AR(1) noise."""
 
 import numpy as np
+import pytest
 
+from pitotcal.core.errors import PitotcalError
 from pitotcal.core.information import (
     ResidualNoise,
     delta_v_band_kt,
@@ -128,3 +130,6 @@ def test_quantiles_from_the_standard_library_are_scipy_stats_ones():
     assert abs(student_t_isf(0.75, 5.0) / t.isf(0.75, 5.0) - 1) < 1e-12     # the lower half
     for dof in (1.0, 3.0, 1e5, 2e5, 1e8):    # the median, on both routes
         assert student_t_isf(0.5, dof) == t.isf(0.5, dof) == 0.0
+    for p, dof in ((1e-20, 0.1), (1e-160, 1.0), (1e-300, 3.0)):    # t² or the density leaves
+        with pytest.raises(PitotcalError, match="`p`"):                 # the float range
+            student_t_isf(p, dof)

@@ -78,8 +78,12 @@ def student_t_isf(p, dof):
         return z * student_t_widening(v, z)
     t, last = max(z, 1e-3), math.inf
     for _ in range(200):
-        sf, pdf = _t_sf_pdf(t, v)
-        step = (math.log(sf) - math.log(p)) * sf / (pdf * t)   # Newton in log t on log sf
+        try:        # t² overflows or the density underflows in a tail far below 1e-150
+            sf, pdf = _t_sf_pdf(t, v)
+            step = (math.log(sf) - math.log(p)) * sf / (pdf * t)   # Newton in log t on log sf
+        except (ArithmeticError, ValueError):
+            raise PitotcalError(f"`p` {p!r} is too small a tail probability to invert for "
+                                f"`dof` {v!r}", param="p") from None
         step = max(min(step, 2.0), -2.0)
         # quadratic convergence: a step that no longer shrinks below 1e-10 is rounding
         if abs(step) <= 1e-14 or (abs(step) >= last and last < 1e-10):
