@@ -190,7 +190,9 @@ def _data(flight):
                                 "static port and a total-temperature probe", param="flight")
     ps = np.asarray(flight.ps_pa, dtype=float)
     qci = np.asarray(flight.qci_pa, dtype=float)
-    for name in ("ps_pa", "tat_k", "qci_pa", "gps_vn_mps", "gps_ve_mps"):
+    for name in ("ps_pa", "tat_k", "qci_pa", "gps_vn_mps", "gps_ve_mps", "gps_vd_mps"):
+        if getattr(flight, name) is None:       # the vertical channel is optional
+            continue
         values = np.asarray(getattr(flight, name), dtype=float)
         if not np.all(np.isfinite(values)) or (name in ("ps_pa", "tat_k") and np.any(values <= 0)):
             raise PitotcalError(f"`flight` {name} has a sample that is not a positive finite "

@@ -108,6 +108,10 @@ def test_a_flight_with_a_bad_sample_is_refused():
     tat[3] = np.nan
     with pytest.raises(PitotcalError, match="`flight` tat_k has a sample"):
         identify_mach(Flight(**{**flight.__dict__, "tat_k": tat}))
+    vd = np.zeros(flight.n) if flight.gps_vd_mps is None else flight.gps_vd_mps.copy()
+    vd[3] = np.nan              # the optional vertical channel too (was a LinAlgError)
+    with pytest.raises(PitotcalError, match="`flight` gps_vd_mps has a sample"):
+        identify_mach(Flight(**{**flight.__dict__, "gps_vd_mps": vd}))
 
 
 def test_position_corrections_follow_the_static_error():
