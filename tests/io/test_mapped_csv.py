@@ -172,3 +172,11 @@ def test_a_bad_row_is_named_as_the_export_numbers_it(export, tmp_path):
     with pytest.raises(PitotcalError, match=r"column qc_pa, row 41 \(line 42\): NaN .*"
                                             r"\[qc_pa is pt_psi - ps_hpa via "):
         read_flight(bad, columns=mapping)
+
+
+@pytest.mark.parametrize("bad", [0.0, 3.5, float("nan"), "fast", None])
+def test_a_bad_mach_ic_max_is_refused_by_name(bad, tmp_path):
+    from pitotcal.io.mapped_csv import read_mapped_csv
+
+    with pytest.raises(PitotcalError, match="`mach_ic_max`"):
+        read_mapped_csv(tmp_path / "none.csv", tmp_path / "none.toml", mach_ic_max=bad)

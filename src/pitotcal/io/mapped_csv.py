@@ -165,6 +165,10 @@ def read_mapped_csv(path, columns, start_s=None, end_s=None, *, temp_recovery=1.
     FlightDataError
         Unusable data, as for a flight CSV; the message names the export's column.
     """
+    try:
+        mach_ic_max = float(mach_ic_max)
+    except (TypeError, ValueError):
+        mach_ic_max = float("nan")     # refused below, by name
     if not 0.0 < mach_ic_max <= MACH_IC_MAX:
         raise PitotcalError(f"`mach_ic_max` {mach_ic_max!r} must be in (0, {MACH_IC_MAX:g}]",
                             param="mach_ic_max")
