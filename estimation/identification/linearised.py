@@ -137,8 +137,11 @@ class Linearised:
         return np.column_stack(cols)
 
     def _step(self, theta, ch, q_smooth):
-        """−J⁻¹ [g(θ; perturbed) − g(θ̂; unperturbed)]."""
-        return -np.linalg.solve(self.jacobian, self._g(theta, ch, q_smooth) - self.g0)
+        """−J⁻¹ [g(θ; perturbed) − g(θ̂; unperturbed)]; a singular J is `NotLinear`."""
+        try:
+            return -np.linalg.solve(self.jacobian, self._g(theta, ch, q_smooth) - self.g0)
+        except np.linalg.LinAlgError:
+            raise NotLinear("its Jacobian is singular") from None
 
     def solve(self, perturbed):
         """`result` with the estimate θ̂ + Δθ of `perturbed`: `fitted` perturbed.

@@ -136,6 +136,23 @@ def test_a_term_not_linear_enough_is_resolved_with_a_note(monkeypatch):
     assert any("qc_scale term is re-solved, not linearised" in w for w in b.warnings)
 
 
+def test_a_singular_jacobian_sends_every_term_to_resolves(monkeypatch):
+    """An exactly singular Jacobian (no plausible flight made one) is not linearisable: each
+    term is re-solved and named, never a LinAlgError."""
+    flight = _synthetic()
+    result = identify(flight)
+    real = linearised.Linearised.__init__
+
+    def singular(self, *args):
+        real(self, *args)
+        self.jacobian = np.zeros_like(self.jacobian)
+    monkeypatch.setattr(linearised.Linearised, "__init__", singular)
+    with pytest.warns(UserWarning, match="re-solved"):
+        b = bd.uncertainty_budget(flight, result, INPUTS)
+    resolved = bd.uncertainty_budget(flight, result, INPUTS, method="resolve")
+    np.testing.assert_array_equal(b.terms_kt["qc_scale"], resolved.terms_kt["qc_scale"])
+
+
 def test_an_unknown_method_is_refused():
     flight = _synthetic()
     with pytest.raises(PitotcalError, match="method"):
