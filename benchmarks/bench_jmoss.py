@@ -25,7 +25,6 @@ import numpy as np
 
 from pitotcal.studies.jets.study import TPS_EXPORT_MAP
 
-ROOT = Path(__file__).resolve().parents[1]
 SOURCE = "https://github.com/SaguaroAerospaceResearch/JMOSS"
 COMMIT = "8d5b162"
 FIXES = (("JMOSS/utilities.py", "mach[index] = sol\n", "mach[index] = sol[0]\n"),
@@ -158,7 +157,11 @@ def _wind_ne(result):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--data", type=Path, default=ROOT.parent / "shared" / "data" / "jmoss")
+    shared = os.environ.get("PITOTCAL_SHARED_DATA")
+    ap.add_argument("--data", type=Path, required=shared is None,
+                    default=Path(shared) / "jmoss" if shared else None,
+                    help="folder of the CLASS*.csv test points and WB.txt "
+                         "(default: jmoss/ in $PITOTCAL_SHARED_DATA)")
     ap.add_argument("--points", nargs="+", default=["CLASS55", "CLASS65"])
     ap.add_argument("--cache", type=Path, default=Path.home() / ".cache" / "pitotcal")
     ap.add_argument("--source", default=SOURCE, help="JMOSS git URL (or a local clone)")

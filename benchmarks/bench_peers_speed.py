@@ -7,7 +7,7 @@ Run: ``python benchmarks/bench_peers_speed.py [--sizes 16000 100000 1000000] [--
 Each size is a seeded synthetic flight (tests/synthetic.py: 50 Hz, 5 Hz held GPS with 0.05 m/s
 noise, 0.5 Pa pressure noise, k = (0.02, -15 Pa), 5 m/s wind from 270 deg, 70-100 kt) written
 as a pitotcal CSV; the ArduPlane SITL log is added when the shared data holds it
-(PITOTCAL_SHARED_DATA, else ../shared/data). The three commands alternate in fresh processes
+(the folder PITOTCAL_SHARED_DATA names). The three commands alternate in fresh processes
 (interleaved, so load changes hit all three alike); each child's wall time is timed here and its peak RSS
 comes from /usr/bin/time. Medians of `--repeats` runs (`--repeats-large` above 200,000 samples). The
 AirspeedFit core comes from $PITOTCAL_WEBTOOLS (a WebTools checkout), else the cache
@@ -77,9 +77,7 @@ def find_airspeedfit(fetch=True):
 
 def sitl_log():
     base = os.environ.get("PITOTCAL_SHARED_DATA")
-    base = Path(base) if base else next(
-        (p / "shared" / "data" for p in ROOT.parents if (p / "shared" / "data").is_dir()), None)
-    log = base / "ardupilot" / "arduplane_sitl.log" if base else None
+    log = Path(base) / "ardupilot" / "arduplane_sitl.log" if base else None
     return log if log is not None and log.is_file() else None
 
 
