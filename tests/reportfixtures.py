@@ -53,3 +53,13 @@ def result_json(dv_kt=-1.0, band_kt=0.3, u_kt=None, dh_ft=None, dh_2sigma_ft=2.0
                          for i in range(3)]
         out["global"] = {"model": "inverse", "dv_kt_at_80": -1.0}
     return out
+
+
+def setting(path, value):
+    """An edit of a parsed JSON document: the key at `path` (keys and indices) set to `value`."""
+    def edit(doc):
+        node = doc
+        for key in path[:-1]:
+            node = node[key]
+        node[path[-1]] = value
+    return edit

@@ -4,6 +4,7 @@ file and key or flag, exit 2, no traceback."""
 import json
 
 import pytest
+from reportfixtures import setting
 
 import pitotcal
 from pitotcal.cli import main
@@ -42,15 +43,6 @@ def _refused(argv, capsys, *words):
     return err
 
 
-def _set(path, value):
-    def edit(doc):
-        node = doc
-        for key in path[:-1]:
-            node = node[key]
-        node[path[-1]] = value
-    return edit
-
-
 def test_report_on_deeply_nested_json(tmp_path, capsys):
     deep = tmp_path / "deep.json"
     deep.write_text("[" * 100_000)
@@ -72,7 +64,7 @@ def test_report_aircraft_binary_file(flown, tmp_path, capsys):
 ])
 def test_monitor_refuses_a_garbage_calibration(case, path, value, key, flown, tmp_path,
                                               capsys):
-    cal = _edited(flown, tmp_path, _set(path, value))
+    cal = _edited(flown, tmp_path, setting(path, value))
     _refused(["monitor", flown[0], "--calibration", cal], capsys, key, "--calibration")
 
 
@@ -87,7 +79,7 @@ def test_monitor_idle_s_nan_on_a_file(flown, capsys):
 
 
 def test_plan_calibration_k1_099(flown, tmp_path, capsys):
-    cal = _edited(flown, tmp_path, _set(("parameters", "k1", "value"), 0.99))
+    cal = _edited(flown, tmp_path, setting(("parameters", "k1", "value"), 0.99))
     _refused(["plan", "--calibration", cal, "-o", tmp_path / "p.csv"], capsys,
              "parameters.k1.value", "|dp/qc| reaches 0.98")
 

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from plans import circle_plan
+from reportfixtures import setting
 
 from pitotcal.cli import build_parser, main
 from pitotcal.io.plan_csv import write_plan
@@ -184,14 +185,6 @@ def _results(root, result):
         edit(d)
         (root / f"res_{name}.json").write_text(json.dumps(d))
 
-    def setter(path, value):
-        def edit(d):
-            node = d
-            for key in path[:-1]:
-                node = node[key]
-            node[path[-1]] = value
-        return edit
-
     def deleter(path):
         def edit(d):
             node = d
@@ -212,25 +205,25 @@ def _results(root, result):
     for name, value in (("k1_nan", float("nan")), ("k1_inf", float("inf")), ("k1_1e200", 1e200),
                         ("k1_099", 0.99), ("k1_str", "0.01"), ("k1_null", None),
                         ("k1_list", [0.01]), ("k1_bool", True)):
-        edited(name, setter(k1, value))
+        edited(name, setting(k1, value))
     edited("no_parameters", deleter(("parameters",)))
     edited("no_k1", deleter(("parameters", "k1")))
-    edited("params_list", setter(("parameters",), [1, 2]))
+    edited("params_list", setting(("parameters",), [1, 2]))
     if "noise_std_pa" in doc:
-        edited("noise_zero", setter(("noise_std_pa",), 0.0))
-        edited("noise_neg", setter(("noise_std_pa",), -1.0))
-    edited("model_unknown", setter(("model",), "cubic"))
+        edited("noise_zero", setting(("noise_std_pa",), 0.0))
+        edited("noise_neg", setting(("noise_std_pa",), -1.0))
+    edited("model_unknown", setting(("model",), "cubic"))
     for key in ("rel_std", "std_mps", "ar1", "block_s"):
         if key in doc.get("noise_model", {}):
-            edited(f"nm_{key}_nan", setter(("noise_model", key), float("nan")))
-            edited(f"nm_{key}_neg", setter(("noise_model", key), -5.0))
+            edited(f"nm_{key}_nan", setting(("noise_model", key), float("nan")))
+            edited(f"nm_{key}_neg", setting(("noise_model", key), -5.0))
     rows = "airspeed_correction"
     if doc.get(rows):
         edited("table_vi_neg", lambda d: d[rows][0].__setitem__("vi_kt", -50.0))
         edited("table_vi_str", lambda d: d[rows][0].__setitem__("vi_kt", "fast"))
         edited("table_dv_nan", lambda d: d[rows][0].__setitem__("dv_kt", float("nan")))
-        edited("table_not_list", setter((rows,), {"a": 1}))
-        edited("table_rows_str", setter((rows,), ["x", "y"]))
+        edited("table_not_list", setting((rows,), {"a": 1}))
+        edited("table_rows_str", setting((rows,), ["x", "y"]))
     edited("outer_list", lambda d: None)
     (root / "res_outer_list.json").write_text(json.dumps([doc]))
 
