@@ -130,3 +130,19 @@ def _hold_index(t, rate_hz):
     period = 1.0 / rate_hz
     tick = np.floor((t - t[0]) / period + 1e-9) * period + t[0]
     return np.searchsorted(t, tick - 1e-9)
+
+
+def reference_static_flight():
+    """A simulated compressible flight (90-150 KCAS at 8,000 ft, calm, seed 2) with a reference
+    static pressure 40 Pa below the static port's."""
+    import dataclasses
+
+    from plans import circle_plan
+
+    from pitotcal.maneuvers.fly.simulator import simulate
+
+    plan = circle_plan(duration_s=180.0, cas_kt=(90.0, 150.0), radius_m=1500.0,
+                       altitude_m=2438.4, wind_speed_mps=5.0)
+    flight, _ = simulate(plan, seed=2, turbulence_mps=0.0, rate_hz=10.0,
+                         air_data="compressible")
+    return dataclasses.replace(flight, ps_ref_pa=flight.ps_pa - 40.0)

@@ -10,9 +10,7 @@ from pitotcal.estimation import identify
 from pitotcal.estimation.identification import budget as bd
 from pitotcal.estimation.identification import fit as fit_module
 from pitotcal.estimation.identification import linearised
-from pitotcal.maneuvers.fly.simulator import simulate
-from plans import circle_plan
-from synthetic import synthetic_flight
+from synthetic import reference_static_flight, synthetic_flight
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import delta_v_kt_where_defined, get_model
@@ -39,11 +37,7 @@ def _synthetic(spikes=False):
 
 def _reference():
     """Compressible with a reference static pressure 40 Pa below the static port's."""
-    plan = circle_plan(duration_s=180.0, cas_kt=(90.0, 150.0), radius_m=1500.0,
-                       altitude_m=2438.4, wind_speed_mps=5.0)
-    flight, _ = simulate(plan, seed=2, turbulence_mps=0.0, rate_hz=10.0,
-                         air_data="compressible")
-    return dataclasses.replace(flight, ps_ref_pa=flight.ps_pa - 40.0)
+    return reference_static_flight()
 
 
 @pytest.fixture(scope="module", params=[("synthetic", "incompressible"),

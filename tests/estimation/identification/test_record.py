@@ -1,7 +1,6 @@
 """The result record: `identify` computes every product once and `to_dict` writes it; the one
 reader, `read_result`, validates what it returns."""
 
-import dataclasses
 import json
 
 import numpy as np
@@ -12,8 +11,7 @@ from pitotcal.estimation.identification.identify import identify
 from pitotcal.estimation.monitor.model import Calibration
 from pitotcal.estimation.uncertainty.block_noise import block_residual_stats
 from pitotcal.estimation.reporting.budget_tables import add_budget
-from pitotcal.maneuvers.fly.simulator import simulate
-from plans import circle_plan
+from synthetic import reference_static_flight
 
 from pitotcal.core.errors import PitotcalError
 from pitotcal.io import read_flight, write_flight_csv
@@ -25,11 +23,7 @@ TRUE_K = (0.02, -15.0)       # circle_plan's default truth (tests/plans.py)
 @pytest.fixture(scope="module")
 def reference_flight():
     """A compressible flight with a reference static pressure 40 Pa below the static port's."""
-    plan = circle_plan(duration_s=180.0, cas_kt=(90.0, 150.0), radius_m=1500.0,
-                       altitude_m=2438.4, wind_speed_mps=5.0)
-    flight, _ = simulate(plan, seed=2, turbulence_mps=0.0, rate_hz=10.0,
-                         air_data="compressible")
-    return dataclasses.replace(flight, ps_ref_pa=flight.ps_pa - 40.0)
+    return reference_static_flight()
 
 
 def test_static_source_fit_runs_once_per_identification(reference_flight, monkeypatch, tmp_path):
