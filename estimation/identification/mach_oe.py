@@ -31,6 +31,7 @@ from pitotcal.core.airdata import (GAMMA, QC_OVER_PS_MAX, cas_from_qc_mps, mach_
                                    pressure_altitude_m, qc_from_mach_pa)
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import mach_knots, mach_spline_basis
+from pitotcal.core.moist_air import total_temperature_ratio
 from pitotcal.core.units import ISA_LAPSE_KPM, R_AIR_JKGK, m_to_ft, mps_to_kt
 
 from ..uncertainty.covariance import colored_covariance
@@ -206,7 +207,7 @@ def _data(flight):
     return {"ps_pa": ps, "pt_pa": ps + qci, "tat_k": tat, "mach_ic": mach_ic,
             "dh_m": h - np.median(h), "vg": np.column_stack([flight.gps_vn_mps,
                                                              flight.gps_ve_mps, vd]),
-            "oat0_k": float(np.mean(tat / (1.0 + 0.2 * mach_ic ** 2)))}
+            "oat0_k": float(np.mean(tat / total_temperature_ratio(mach_ic)))}
 
 
 def _outputs(x, data):
@@ -216,7 +217,7 @@ def _outputs(x, data):
     oat = x[k + 3] - ISA_LAPSE_KPM * data["dh_m"]
     tas = np.linalg.norm(data["vg"] - np.array([x[k], x[k + 1], 0.0]), axis=1)
     mach = np.minimum(tas / np.sqrt(GAMMA * R_AIR_JKGK * oat), 3.0)
-    r_t = oat * (1.0 + 0.2 * x[k + 2] * mach ** 2) - data["tat_k"]
+    r_t = oat * total_temperature_ratio(mach, x[k + 2]) - data["tat_k"]
     r_q = qc_from_mach_pa(mach, ps) - (data["pt_pa"] - ps)
     return r_q, r_t
 

@@ -41,6 +41,7 @@ from scipy.optimize import least_squares
 from pitotcal.core import checks
 from pitotcal.core.airdata import GAMMA, QC_OVER_PS_MAX, mach_from_qc
 from pitotcal.core.errors import PitotcalError
+from pitotcal.core.moist_air import total_temperature_ratio
 from pitotcal.core.units import G0_MPS2, ISA_LAPSE_KPM, R_AIR_JKGK
 
 from ..uncertainty.covariance import colored_covariance
@@ -199,7 +200,7 @@ def _data(flight, attitude=None):
     keep = (np.abs(ratio) <= QC_OVER_PS_MAX) & np.isfinite(flight.alt_m)
     vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(ps.size)
     h = np.asarray(flight.alt_m, dtype=float)[keep]
-    oat0 = np.asarray(flight.tat_k)[keep] / (1.0 + 0.2 * mach_from_qc(ratio[keep], 1.0) ** 2)
+    oat0 = np.asarray(flight.tat_k)[keep] / total_temperature_ratio(mach_from_qc(ratio[keep], 1.0))
     vg = np.column_stack([flight.gps_vn_mps, flight.gps_ve_mps, vd])[keep]
     extra = {}
     if attitude is not None:
@@ -242,7 +243,7 @@ def _true_mach(data, p):
 
 
 def _static_temperature(data, p, recovery):
-    return data["tat_k"] / (1.0 + 0.2 * recovery * _true_mach(data, p) ** 2)
+    return data["tat_k"] / total_temperature_ratio(_true_mach(data, p), recovery)
 
 
 def _residual(xs, data, fit, profile):

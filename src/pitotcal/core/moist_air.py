@@ -42,6 +42,7 @@ __all__ = [
     "ram_rise_note",
     "saturation_vapour_pressure_pa",
     "static_temperature_k",
+    "total_temperature_ratio",
     "virtual_temperature_k",
     "with_static_air",
 ]
@@ -102,8 +103,13 @@ def static_temperature_k(tat_k, qci_pa, ps_pa, recovery=1.0):
     recovery : float
         The probe's recovery factor r, 0-1 (1: an ideal stagnation probe).
     """
-    mach = mach_from_qc(qci_pa, ps_pa)
-    return np.asarray(tat_k, dtype=float) / (1.0 + recovery * 0.2 * mach ** 2)
+    return np.asarray(tat_k, dtype=float) / total_temperature_ratio(mach_from_qc(qci_pa, ps_pa),
+                                                                     recovery)
+
+
+def total_temperature_ratio(mach, recovery=1.0):
+    """T_t / T_s = 1 + r (γ − 1)/2 M² of a temperature probe with recovery factor r."""
+    return 1.0 + recovery * 0.2 * np.asarray(mach, dtype=float) ** 2
 
 
 def at_mach(flight, mach):
@@ -120,7 +126,7 @@ def at_mach(flight, mach):
     recovery = reading.get("temp_recovery")
     if recovery is None:                    # made in memory: the factor the source names
         recovery = float(source.rsplit(" ", 1)[-1])
-    t_air = np.asarray(flight.tat_k, float) / (1.0 + recovery * 0.2 * np.asarray(mach) ** 2)
+    t_air = np.asarray(flight.tat_k, float) / total_temperature_ratio(mach, recovery)
     if flight.meta.get(_OAT_VIRTUAL) and flight.rh_pct is not None:
         t_air = virtual_temperature_k(t_air, flight.ps_pa, flight.rh_pct)
     return dataclasses.replace(flight, oat_k=t_air, rho_kgm3=flight.ps_pa / (R_AIR_JKGK * t_air))

@@ -36,6 +36,7 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.errors import FlightDataError
+from pitotcal.core.moist_air import total_temperature_ratio
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS
 from .atomic import atomic_open
 from .read_once import naming, open_binary, read_once
@@ -199,7 +200,7 @@ def read_legs(path, temp_recovery=DEFAULT_TEMP_RECOVERY):
     temperature, tat_k = column, None
     if column.startswith("tat"):
         mach = airdata.mach_from_qc(qci, airdata.static_pressure_pa(alt_m))
-        tat_k, kelvin = kelvin, kelvin / (1.0 + temp_recovery * 0.2 * mach ** 2)
+        tat_k, kelvin = kelvin, kelvin / total_temperature_ratio(mach, temp_recovery)
         temperature = f"{column}, recovery factor {temp_recovery:g}"
     legs = LegData(point=labels, ias_kt=ias_kt, qci_pa=qci, pressure_alt_m=alt_m, oat_k=kelvin,
                    groundspeed_mps=values["groundspeed_kt"] * KT_TO_MPS,
