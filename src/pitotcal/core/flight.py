@@ -49,6 +49,10 @@ class Flight:
     reading : dict or None
         How `pitotcal.io.read_flight` read the file and made its air data, once: start_s,
         end_s, oat_k, temp_recovery, rh_pct, oat_source. None for a flight made in memory.
+    segment : ndarray of int or None
+        Which calibration window each sample belongs to (0, 1, ...), when the flight is several
+        disjoint windows of one log: they share the calibration and each keeps its own wind.
+        None: one window.
     """
 
     time_s: np.ndarray
@@ -69,6 +73,7 @@ class Flight:
     tat_k: np.ndarray | None = None
     rh_pct: np.ndarray | None = None
     reading: dict | None = None
+    segment: np.ndarray | None = None
 
     @property
     def n(self):
@@ -88,4 +93,4 @@ class Flight:
 
 
 _ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m", "ps_pa",
-           "oat_k", "ps_ref_pa", "tat_k", "rh_pct")
+           "oat_k", "ps_ref_pa", "tat_k", "rh_pct", "segment")
