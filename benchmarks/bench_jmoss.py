@@ -23,19 +23,14 @@ from pathlib import Path
 
 import numpy as np
 
-from pitotcal.studies.jets.study import TPS_EXPORT_MAP
+from pitotcal.studies.jets.study import TPS_ATTITUDE_MAP, TPS_EXPORT_MAP
 
 SOURCE = "https://github.com/SaguaroAerospaceResearch/JMOSS"
 COMMIT = "8d5b162"
 FIXES = (("JMOSS/utilities.py", "mach[index] = sol\n", "mach[index] = sol[0]\n"),
          ("JMOSS/visualization.py", "cm.get_cmap('tab20').colors",
           "__import__('matplotlib').colormaps['tab20'].colors"))
-MAPPING = TPS_EXPORT_MAP + """\
-roll              = { column = "roll_angle_rad",   unit = "rad" }
-pitch             = { column = "pitch_angle_rad",  unit = "rad" }
-true_heading      = { column = "true_heading_rad", unit = "rad" }
-sideslip          = { column = "aos_rad",          unit = "rad" }
-"""
+MAPPING = TPS_EXPORT_MAP + TPS_ATTITUDE_MAP
 GRID = [0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 1.0]
 
 # Run by the JMOSS interpreter: argv = repo, out.json, files...

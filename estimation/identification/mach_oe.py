@@ -19,6 +19,28 @@ intercept is the OAT and whose slope is the recovery; without it r would trade a
 The outputs are weighted by their residual variances (estimated, two passes); the covariance
 is the colored-residual one of `estimation.uncertainty.covariance`. r is bounded by
 `recovery_bounds` (a probe recovers at most the whole stagnation rise: r <= 1).
+
+With the attitude (`attitude`: heading, pitch, roll and the sideslip vane), the airspeed's
+direction u (`pitotcal.core.airspeed_direction`) gives a third output, the horizontal air
+velocity across it,
+
+    r_y = û_φ × (V_g − W)_h   (m/s),   û_φ = u_h turned by φ = δ + τ dψ/dt,
+
+with two unknowns stated before any data are seen: δ, a constant misalignment of the heading
+and the vane with the airspeed (an installation or vane offset: 1° is 4 m/s of wind at
+250 m/s), and τ, the attitude's time offset against the GPS velocity (in a turn at rate dψ/dt
+it turns the direction by τ dψ/dt). The magnitude alone finds the wind from the variation of
+ground speed with heading; the direction adds the cross-track component at every sample. A
+full turn separates δ and τ from the wind (both rotate with the aircraft, the wind does not);
+on a single heading δ and the cross-track wind are one number.
+
+The spline's representation error, what knots this far apart cannot follow, is not in the
+fitted covariance. It is measured by fitting again with a knot added midway in every interval
+the data fill (`pitotcal.core.models.denser_knots`): the largest difference of the two curves
+within each of the coarse intervals is taken as a 1σ there and added in quadrature to the
+curve's variance (`spline_sigma`). For a smooth curve the denser spline's own error is an
+order smaller (a cubic spline's error falls with the fourth power of the spacing), so the
+difference measures the coarse one's.
 """
 
 import dataclasses
@@ -29,8 +51,10 @@ from scipy.optimize import least_squares
 from pitotcal.core import checks
 from pitotcal.core.airdata import (GAMMA, QC_OVER_PS_MAX, cas_from_qc_mps, mach_from_qc,
                                    pressure_altitude_m, qc_from_mach_pa)
+from pitotcal.core.airspeed_direction import (airspeed_direction, aligned_attitude,
+                                              heading_rate_rps, rotated_horizontal)
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.models import mach_knots, mach_spline_basis
+from pitotcal.core.models import denser_knots, mach_knots, mach_spline_basis
 from pitotcal.core.moist_air import total_temperature_ratio
 from pitotcal.core.units import ISA_LAPSE_KPM, R_AIR_JKGK, m_to_ft, mps_to_kt
 
@@ -44,9 +68,13 @@ RECOVERY_BOUNDS = (0.5, 1.0)
 # M_ic where the curve is tabulated (within the data's range).
 MACH_GRID = tuple(np.round(np.arange(0.4, 3.0001, 0.025), 3))
 _CP_JKGK = GAMMA * R_AIR_JKGK / (GAMMA - 1.0)
-# The first pass's output scales (Pa, K): a 0.3 m/s airspeed at 250 m/s and 0.5 kg/m³, a probe's
-# fraction of a kelvin; the second pass uses the first's residual RMS.
-_PRIOR_SIGMAS = (40.0, 0.5)
+# The first pass's output scales (Pa, K, m/s): a 0.3 m/s airspeed at 250 m/s and 0.5 kg/m³, a
+# probe's fraction of a kelvin, a metre per second across the airspeed; the second pass uses the
+# first's residual RMS.
+_PRIOR_SIGMAS = (40.0, 0.5, 1.0)
+# the unknowns after the spline's: their names and scales
+_NAMES = ("wind_n_mps", "wind_e_mps", "recovery", "oat_k", "misalignment_rad", "latency_s")
+_SCALES = (1.0, 1.0, 0.1, 10.0, 0.01, 0.1)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,15 +92,25 @@ class MachFitResult:
     wind_n_mps, wind_e_mps, recovery, oat_k : float
         The wind (the air mass's velocity), the probe's recovery factor, the static temperature
         at the median GPS height.
-    covariance : ndarray (K + 4, K + 4)
-        Of (dpp_ps_knots..., wind_n_mps, wind_e_mps, recovery, oat_k).
+    covariance : ndarray (K + 4, K + 4) or (K + 6, K + 6)
+        Of (dpp_ps_knots..., wind_n_mps, wind_e_mps, recovery, oat_k[, misalignment_rad,
+        latency_s]).
     recovery_at_bound : bool
         r sits on a bound of `recovery_bounds`; the covariance is the local one there.
     spe : list of dict
         The curve on `MACH_GRID` within the data: {"mach_ic", "dpp_ps", "dpp_ps_2sigma",
-        "dv_kt", "dm", "dh_ft"} (ΔV_pc, ΔM_pc, ΔH_pc at the test point's median static pressure).
+        "dpp_ps_spline_2sigma", "dv_kt", "dm", "dh_ft"} (the 2σ includes the spline's term,
+        given alone too; ΔV_pc, ΔM_pc, ΔH_pc at the test point's median static pressure).
     sigma_q_pa, sigma_t_k : float
         RMS of the two outputs' residuals.
+    airspeed_model : str
+        "magnitude" (|V_g − W| = V_t) or "vector" (with the attitude: the direction too).
+    misalignment_rad, latency_s, sigma_y_mps : float
+        With the attitude: δ and τ (module notes) and the RMS of the cross-track output's
+        residual, m/s; 0, 0 and NaN without.
+    spline_sigma : ndarray (K − 1,)
+        1σ of the spline's representation error in each knot interval (module notes); in the
+        curve's 2σ.
     n_fit : int
         Samples fitted (all of them).
     mach_ic_max : float
@@ -94,17 +132,27 @@ class MachFitResult:
     sigma_t_k: float
     n_fit: int
     mach_ic_max: float
+    airspeed_model: str = "magnitude"
+    misalignment_rad: float = 0.0
+    latency_s: float = 0.0
+    sigma_y_mps: float = float("nan")
+    spline_sigma: np.ndarray = None
 
     def std(self, name):
-        """1σ of "wind_n_mps", "wind_e_mps", "recovery" or "oat_k"."""
-        i = self.knots.size + ("wind_n_mps", "wind_e_mps", "recovery", "oat_k").index(name)
-        return float(np.sqrt(self.covariance[i, i]))
+        """1σ of "wind_n_mps", "wind_e_mps", "recovery", "oat_k", "misalignment_rad" or
+        "latency_s" (0 for the last two without the attitude)."""
+        i = self.knots.size + _NAMES.index(name)
+        return float(np.sqrt(self.covariance[i, i])) if i < len(self.covariance) else 0.0
 
-    def dpp_ps(self, mach_ic):
-        """(Δp_p/p_s, its 2σ) at `mach_ic` (array)."""
-        basis = mach_spline_basis(np.atleast_1d(np.asarray(mach_ic, dtype=float)), self.knots)
+    def dpp_ps(self, mach_ic, spline=True):
+        """(Δp_p/p_s, its 2σ) at `mach_ic` (array); the 2σ with the spline's representation
+        error unless `spline` is False."""
+        m = np.atleast_1d(np.asarray(mach_ic, dtype=float))
+        basis = mach_spline_basis(m, self.knots)
         k = self.knots.size
         var = np.einsum("ij,jk,ik->i", basis, self.covariance[:k, :k], basis)
+        if spline and self.spline_sigma is not None:
+            var = var + self.spline_sigma[_interval(m, self.knots)] ** 2
         return basis @ self.dpp_ps_knots, 2.0 * np.sqrt(np.maximum(var, 0.0))
 
     def to_dict(self):
@@ -117,10 +165,16 @@ class MachFitResult:
                 "recovery_at_bound": self.recovery_at_bound, "oat_k": self.oat_k,
                 "oat_2sigma_k": 2.0 * self.std("oat_k"), "sigma_q_pa": self.sigma_q_pa,
                 "sigma_t_k": self.sigma_t_k, "n_fit": self.n_fit,
-                "mach_ic_max": self.mach_ic_max, "spe": self.spe}
+                "mach_ic_max": self.mach_ic_max, "airspeed_model": self.airspeed_model,
+                "misalignment_deg": float(np.degrees(self.misalignment_rad)),
+                "misalignment_2sigma_deg": float(np.degrees(2.0 * self.std("misalignment_rad"))),
+                "latency_s": self.latency_s, "latency_2sigma_s": 2.0 * self.std("latency_s"),
+                "sigma_y_mps": None if np.isnan(self.sigma_y_mps) else self.sigma_y_mps,
+                "spe": self.spe}
 
 
-def identify_mach(flight, *, knots=None, recovery_bounds=RECOVERY_BOUNDS):
+def identify_mach(flight, *, knots=None, recovery_bounds=RECOVERY_BOUNDS, attitude=None,
+                  spline_error=True):
     """Fit the Mach-dependent static error, the wind, the recovery and the OAT (module notes).
 
     Parameters
@@ -133,38 +187,90 @@ def identify_mach(flight, *, knots=None, recovery_bounds=RECOVERY_BOUNDS):
         (`pitotcal.core.models.mach_knots`: dense through the transonic region).
     recovery_bounds : (float, float)
         Lowest and highest recovery factor of the probe.
+    attitude : dict of ndarray, optional
+        `time_s`, `roll_rad`, `pitch_rad`, `heading_rad` (true) and optionally `sideslip_rad`
+        (e.g. from `pitotcal.io.mapped_csv.read_attitude`): the airspeed's direction becomes a
+        third output, with the misalignment and the time offset as unknowns (module notes).
+    spline_error : bool
+        Measure the spline's representation error (a second fit, denser knots) and carry it in
+        the curve's 2σ.
 
     Returns
     -------
     MachFitResult
     """
     r_lo, r_hi = checks.recovery_bounds(recovery_bounds)
-    data = _data(flight)
+    data = _data(flight, attitude)
     knots = mach_knots(data["mach_ic"]) if knots is None else _knots(knots)
-    data["basis"] = mach_spline_basis(data["mach_ic"], knots)
     k = knots.size
-    scale = np.r_[np.full(k, 0.01), 1.0, 1.0, 0.1, 10.0]
-    start = np.r_[np.full(k, 0.01), _ram_line(data, r_lo, r_hi)]
-    lower = np.r_[np.full(k + 2, -np.inf), r_lo, 150.0]
-    upper = np.r_[np.full(k + 2, np.inf), max(r_hi, r_lo + 1e-9), 350.0]   # low = high: r fixed
-    weights = _PRIOR_SIGMAS
-    for _ in range(2):          # the outputs' variances from the previous pass
-        sol = least_squares(_residual, start / scale, args=(data, scale, weights),
-                            bounds=(lower / scale, upper / scale), method="trf", x_scale=1.0)
-        rq, rt = _outputs(sol.x * scale, data)
-        weights = (float(np.sqrt(np.mean(rq ** 2))), float(np.sqrt(np.mean(rt ** 2))))
-        start = sol.x * scale
-    x = sol.x * scale
+    vector = "u" in data
+    start = np.r_[np.full(k, 0.01), _ram_line(data, r_lo, r_hi), np.zeros(2 if vector else 0)]
+    x, sol, weights, scale = _solve(data, knots, start, (r_lo, r_hi),
+                                    _PRIOR_SIGMAS[:3 if vector else 2], passes=2)
     cov = colored_covariance(sol.jac, sol.fun, window="exponential").covariance \
         * np.outer(scale, scale)
+    spline_sigma = (_spline_sigma(data, knots, x, cov, (r_lo, r_hi), weights) if spline_error
+                    else np.zeros(k - 1))
     result = MachFitResult(
         success=bool(sol.success), message=str(sol.message), knots=knots,
         dpp_ps_knots=x[:k], wind_n_mps=float(x[k]), wind_e_mps=float(x[k + 1]),
         recovery=float(x[k + 2]), oat_k=float(x[k + 3]), covariance=cov,
         recovery_at_bound=bool(min(x[k + 2] - r_lo, r_hi - x[k + 2]) < 1e-6), spe=[],
         sigma_q_pa=weights[0], sigma_t_k=weights[1], n_fit=int(data["mach_ic"].size),
-        mach_ic_max=float(np.max(data["mach_ic"])))
+        mach_ic_max=float(np.max(data["mach_ic"])),
+        airspeed_model="vector" if vector else "magnitude",
+        misalignment_rad=float(x[k + 4]) if vector else 0.0,
+        latency_s=float(x[k + 5]) if vector else 0.0,
+        sigma_y_mps=weights[2] if vector else float("nan"), spline_sigma=spline_sigma)
     return dataclasses.replace(result, spe=_table(result, data))
+
+
+def _solve(data, knots, start, r_bounds, weights, passes):
+    """Bounded least squares from `start`; each pass reweights the outputs by the residual RMS
+    it leaves. (x, the last solver result, the outputs' RMS at x, the unknowns' scales)."""
+    data = {**data, "basis": mach_spline_basis(data["mach_ic"], knots)}
+    k = knots.size
+    extra = start.size - k - 4
+    scale = np.r_[np.full(k, 0.01), _SCALES[:4 + extra]]
+    lower = np.r_[np.full(k + 2, -np.inf), r_bounds[0], 150.0, np.full(extra, -np.inf)]
+    upper = np.r_[np.full(k + 2, np.inf), max(r_bounds[1], r_bounds[0] + 1e-9), 350.0,
+                  np.full(extra, np.inf)]                   # low = high: r fixed
+    x = start
+    for _ in range(passes):
+        sol = least_squares(_residual, x / scale, args=(data, scale, weights),
+                            bounds=(lower / scale, upper / scale), method="trf", x_scale=1.0)
+        x = sol.x * scale
+        weights = tuple(float(np.sqrt(np.mean(r ** 2))) for r in _outputs(x, data))
+    return x, sol, weights, scale
+
+
+def _spline_sigma(data, knots, x, cov, r_bounds, weights):
+    """1σ of the representation error in each knot interval (module notes): the largest
+    difference within it between this spline and the refit with `denser_knots`, less what the
+    denser fit's extra noise explains (the variance of a nested fit's difference is the
+    difference of the variances)."""
+    k = knots.size
+    dense = denser_knots(knots, data["mach_ic"])
+    if dense.size == k:
+        return np.zeros(k - 1)
+    start = np.r_[mach_spline_basis(dense, knots) @ x[:k], x[k:]]
+    xd, sol, _, scale = _solve(data, dense, start, r_bounds, weights, passes=1)
+    kd = dense.size
+    cov_d = colored_covariance(sol.jac, sol.fun, window="exponential").covariance[:kd, :kd] \
+        * np.outer(scale[:kd], scale[:kd])
+    out = np.zeros(k - 1)
+    for i, (lo, hi) in enumerate(zip(knots[:-1], knots[1:])):
+        m = np.linspace(lo, hi, 21)
+        b, bd = mach_spline_basis(m, knots), mach_spline_basis(m, dense)
+        extra = (np.einsum("ij,jk,ik->i", bd, cov_d, bd)
+                 - np.einsum("ij,jk,ik->i", b, cov[:k, :k], b))
+        out[i] = np.sqrt(np.max(np.maximum((bd @ xd[:kd] - b @ x[:k]) ** 2 - extra, 0.0)))
+    return out
+
+
+def _interval(mach_ic, knots):
+    """Index of the knot interval holding each M_ic (the end intervals beyond the knots)."""
+    return np.clip(np.searchsorted(knots, mach_ic, side="right") - 1, 0, knots.size - 2)
 
 
 def _ram_line(data, r_lo, r_hi):
@@ -183,8 +289,9 @@ def _knots(knots):
     return k
 
 
-def _data(flight):
-    """The arrays the fit needs, SI (every sample)."""
+def _data(flight, attitude=None):
+    """The arrays the fit needs, SI (every sample); with the attitude, `u` the airspeed's
+    direction and `omega` the heading's rate."""
     for name in ("ps_pa", "tat_k"):
         if getattr(flight, name) is None:
             raise PitotcalError(f"`flight` has no {name}: the Mach-dependent fit needs the "
@@ -204,27 +311,38 @@ def _data(flight):
     h = np.asarray(flight.alt_m, dtype=float) if flight.alt_m is not None else np.zeros(ps.size)
     h = np.where(np.isfinite(h), h, np.nanmedian(h) if np.any(np.isfinite(h)) else 0.0)
     tat = np.asarray(flight.tat_k, dtype=float)
-    return {"ps_pa": ps, "pt_pa": ps + qci, "tat_k": tat, "mach_ic": mach_ic,
-            "dh_m": h - np.median(h), "vg": np.column_stack([flight.gps_vn_mps,
-                                                             flight.gps_ve_mps, vd]),
-            "oat0_k": float(np.mean(tat / total_temperature_ratio(mach_ic)))}
+    out = {"ps_pa": ps, "pt_pa": ps + qci, "tat_k": tat, "mach_ic": mach_ic,
+           "dh_m": h - np.median(h), "vg": np.column_stack([flight.gps_vn_mps,
+                                                            flight.gps_ve_mps, vd]),
+           "oat0_k": float(np.mean(tat / total_temperature_ratio(mach_ic)))}
+    if attitude is not None:
+        att = aligned_attitude(attitude, np.asarray(flight.time_s, dtype=float))
+        if not all(np.all(np.isfinite(v)) for v in att.values()):
+            raise PitotcalError("`attitude` has a sample that is not a finite number",
+                                param="attitude")
+        out["u"] = airspeed_direction(att, out["vg"])
+        out["omega"] = heading_rate_rps(att["heading_rad"], flight.time_s)
+    return out
 
 
 def _outputs(x, data):
-    """(r_q Pa, r_T K) per sample at the unknowns `x` (module notes)."""
+    """(r_q Pa, r_T K[, r_y m/s]) per sample at the unknowns `x` (module notes)."""
     k = data["basis"].shape[1]
     ps = data["ps_pa"] * (1.0 - data["basis"] @ x[:k])
     oat = x[k + 3] - ISA_LAPSE_KPM * data["dh_m"]
-    tas = np.linalg.norm(data["vg"] - np.array([x[k], x[k + 1], 0.0]), axis=1)
+    air = data["vg"] - np.array([x[k], x[k + 1], 0.0])
+    tas = np.linalg.norm(air, axis=1)
     mach = np.minimum(tas / np.sqrt(GAMMA * R_AIR_JKGK * oat), 3.0)
     r_t = oat * total_temperature_ratio(mach, x[k + 2]) - data["tat_k"]
     r_q = qc_from_mach_pa(mach, ps) - (data["pt_pa"] - ps)
-    return r_q, r_t
+    if "u" not in data:
+        return r_q, r_t
+    u = rotated_horizontal(data["u"], x[k + 4] + x[k + 5] * data["omega"])
+    return r_q, r_t, u[:, 0] * air[:, 1] - u[:, 1] * air[:, 0]
 
 
 def _residual(xs, data, scale, weights):
-    r_q, r_t = _outputs(xs * scale, data)
-    return np.concatenate([r_q / weights[0], r_t / weights[1]])
+    return np.concatenate([r / w for r, w in zip(_outputs(xs * scale, data), weights)])
 
 
 def position_corrections(mach_ic, dpp_ps, psi_pa):
@@ -248,7 +366,9 @@ def _table(result, data):
     if grid.size == 0:
         return []
     g, g2s = result.dpp_ps(grid)
+    spline_2s = 2.0 * result.spline_sigma[_interval(grid, result.knots)]
     dv, dm, dh = position_corrections(grid, g, float(np.median(data["ps_pa"])))
     return [{"mach_ic": float(m), "dpp_ps": float(a), "dpp_ps_2sigma": float(b),
-             "dv_kt": float(v), "dm": float(d), "dh_ft": float(h)}
-            for m, a, b, v, d, h in zip(grid, g, g2s, dv, dm, dh)]
+             "dpp_ps_spline_2sigma": float(c), "dv_kt": float(v), "dm": float(d),
+             "dh_ft": float(h)}
+            for m, a, b, c, v, d, h in zip(grid, g, g2s, spline_2s, dv, dm, dh)]

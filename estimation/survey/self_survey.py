@@ -40,12 +40,12 @@ from scipy.optimize import least_squares
 
 from pitotcal.core import checks
 from pitotcal.core.airdata import GAMMA, QC_OVER_PS_MAX, mach_from_qc
+from pitotcal.core.airspeed_direction import airspeed_direction, aligned_attitude
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.moist_air import total_temperature_ratio
 from pitotcal.core.units import G0_MPS2, ISA_LAPSE_KPM, R_AIR_JKGK
 
 from ..uncertainty.covariance import colored_covariance
-from .airspeed_direction import airspeed_direction, aligned_attitude
 
 __all__ = ["LAPSE_SIGMA_KPM", "RECOVERY_BOUNDS", "SelfSurveyResult", "hydrostatic_pressure_pa",
            "self_survey"]

@@ -30,14 +30,15 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import m_to_ft, mps_to_kt
 from pitotcal.estimation.identification.mach_oe import identify_mach, position_corrections
 from pitotcal.estimation.survey import self_survey
-from pitotcal.io.mapped_csv import read_mapped_csv
+from pitotcal.io.mapped_csv import ATTITUDE_KEYS, read_attitude, read_column_map, read_mapped_csv
 from pitotcal.io.radiosonde import read_sounding
 
 from ..engine.runner import RunsInterrupted
 from ..engine.study import Collected
 from .figure import plot_jets
 
-__all__ = ["COMPARE_MACH_IC", "STUDY", "TPS_EXPORT_MAP", "JetsStudy", "calibrate_point"]
+__all__ = ["COMPARE_MACH_IC", "STUDY", "TPS_ATTITUDE_MAP", "TPS_EXPORT_MAP", "JetsStudy",
+           "calibrate_point"]
 
 NAME = "jets"
 # The Test Pilot School export's columns (the JMOSS sample format).
@@ -50,6 +51,13 @@ total_pressure    = { column = "total_pres_psi",  unit = "psi" }
 static_pressure   = { column = "static_pres_psi", unit = "psi" }
 total_temperature = { column = "total_temp_K",    unit = "K" }
 gps_height        = { column = "height_ft",       unit = "ft" }
+"""
+# Its attitude and sideslip vane: the output error then compares the airspeed as a vector too.
+TPS_ATTITUDE_MAP = """\
+roll              = { column = "roll_angle_rad",   unit = "rad" }
+pitch             = { column = "pitch_angle_rad",  unit = "rad" }
+true_heading      = { column = "true_heading_rad", unit = "rad" }
+sideslip          = { column = "aos_rad",          unit = "rad" }
 """
 # M_ic where the methods' curves are compared: below the transonic rise, where JMOSS's curve holds.
 COMPARE_MACH_IC = tuple(np.round(np.arange(0.55, 0.9001, 0.05), 2))
@@ -66,7 +74,7 @@ def calibrate_point(path, mapping, sonde=None):
     h_m = float(np.median(flight.alt_m))
     at = sonde.at(h_m) if sonde is not None else None
     start = time.perf_counter()
-    oe = identify_mach(flight)
+    oe = identify_mach(flight, attitude=_attitude(path, mapping))
     oe_s = time.perf_counter() - start
     start = time.perf_counter()
     ss = self_survey(flight)
@@ -80,6 +88,14 @@ def calibrate_point(path, mapping, sonde=None):
                                "wind_e_kt": float(mps_to_kt(at["wind_e_mps"])),
                                "temp_k": at["temp_k"], "ps_pa": at["ps_pa"]}
     return entry
+
+
+def _attitude(path, mapping):
+    """The export's attitude when the mapping names roll, pitch and true heading, else None."""
+    keys = mapping if isinstance(mapping, dict) else read_column_map(mapping)
+    if not all(k in keys for k in ATTITUDE_KEYS[:3]):
+        return None
+    return read_attitude(path, mapping)
 
 
 def _with_corrections(d, psi_pa):
@@ -102,8 +118,13 @@ def _method_entry(name, h_m, d, at, elapsed_s):
            "recovery_2sigma": d["recovery_2sigma"],
            "recovery_at_bound": d["recovery_at_bound"], "n_fit": d["n_fit"],
            "elapsed_s": round(elapsed_s, 2),
-           "spe": [{k: s[k] for k in ("mach_ic", "dpp_ps", "dpp_ps_2sigma", "dv_kt", "dm",
-                                      "dh_ft") if k in s} for s in d["spe"]]}
+           "spe": [{k: s[k] for k in ("mach_ic", "dpp_ps", "dpp_ps_2sigma",
+                                      "dpp_ps_spline_2sigma", "dv_kt", "dm", "dh_ft") if k in s}
+                   for s in d["spe"]]}
+    for key in ("airspeed_model", "misalignment_deg", "misalignment_2sigma_deg", "latency_s",
+                "latency_2sigma_s"):
+        if key in d:
+            out[key] = d[key]
     if at is not None:
         out["wind_miss_kt"] = float(mps_to_kt(np.hypot(d["wind_n_mps"] - at["wind_n_mps"],
                                                        d["wind_e_mps"] - at["wind_e_mps"])))
@@ -217,10 +238,12 @@ class JetsStudy:
 
 
 def _default_mapping():
-    """`TPS_EXPORT_MAP` as the reader's mapping dict: key -> (column, unit)."""
+    """`TPS_EXPORT_MAP` and `TPS_ATTITUDE_MAP` as the reader's mapping dict: key -> (column,
+    unit)."""
     import tomllib
 
-    return {k: (v["column"], v["unit"]) for k, v in tomllib.loads(TPS_EXPORT_MAP).items()}
+    return {k: (v["column"], v["unit"])
+            for k, v in tomllib.loads(TPS_EXPORT_MAP + TPS_ATTITUDE_MAP).items()}
 
 
 def _rows(points):

@@ -14,10 +14,12 @@ from .units import kt_to_mps, mps_to_kt
 
 __all__ = [
     "MAX_PRESSURE_ERROR",
+    "MIN_KNOT_SAMPLES",
     "MODELS",
     "PressureErrorModel",
     "delta_v_kt",
     "delta_v_kt_where_defined",
+    "denser_knots",
     "get_model",
     "mach_knots",
     "mach_spline_basis",
@@ -152,9 +154,11 @@ def worst_pressure_error(model, k, vi_kt, air_data="incompressible"):
 # the transonic rise and fall (a shock crossing the static port moves it by 0.02 within 0.05 of
 # M_ic); the last entry covers supersonic flight.
 _KNOT_SPACING = ((0.8, 0.1), (0.9, 0.05), (1.1, 0.025), (3.0, 0.1))
+# The fewest samples between two knots: each spline coefficient is fitted by data.
+MIN_KNOT_SAMPLES = 40
 
 
-def mach_knots(mach_ic, min_samples=40):
+def mach_knots(mach_ic, min_samples=MIN_KNOT_SAMPLES):
     """Knots of the Mach-dependent error chosen by the data, M_ic.
 
     From the lowest to the highest M_ic of the samples, spaced by `_KNOT_SPACING` (0.1 below
@@ -186,6 +190,21 @@ def mach_knots(mach_ic, min_samples=40):
     if knots[-1] != hi:
         knots[-1] = hi
     return np.array(knots if len(knots) >= 2 else [lo, hi])
+
+
+def denser_knots(knots, mach_ic, min_samples=MIN_KNOT_SAMPLES):
+    """`knots` with the midpoint of each interval added where both halves hold at least
+    `min_samples` samples of `mach_ic`: the spline twice as dense wherever the data can fit it,
+    to measure what the coarser one cannot represent."""
+    m = np.asarray(mach_ic, dtype=float)
+    out = [float(knots[0])]
+    for lo, hi in zip(knots[:-1], knots[1:]):
+        mid = 0.5 * (lo + hi)
+        if min(np.count_nonzero((m > lo) & (m <= mid)),
+               np.count_nonzero((m > mid) & (m <= hi))) >= min_samples:
+            out.append(float(mid))
+        out.append(float(hi))
+    return np.array(out)
 
 
 def _positive(u):

@@ -1,5 +1,6 @@
 """The direction of the airspeed vector in north-east-down axes, from attitude and the sideslip
-vane, for a self-survey that compares the airspeed with GPS as a vector.
+vane, for the methods that compare the airspeed with GPS as a vector (the self-survey, the
+Mach-dependent output error).
 
 As the Test Pilot School's self-survey does (Jurado & McGehee 2019): the angle of attack is
 taken as pitch minus the GPS flight-path angle, α = θ − γ, γ = asin(−V_d / V_h) (the vane's
@@ -12,7 +13,8 @@ import numpy as np
 
 from pitotcal.core.errors import PitotcalError
 
-__all__ = ["ATTITUDE_FIELDS", "airspeed_direction", "aligned_attitude"]
+__all__ = ["ATTITUDE_FIELDS", "airspeed_direction", "aligned_attitude", "heading_rate_rps",
+           "rotated_horizontal"]
 
 ATTITUDE_FIELDS = ("roll_rad", "pitch_rad", "heading_rad")
 
@@ -59,3 +61,19 @@ def _body_to_ned(psi, theta, phi, v):
     y1, z1 = cp * y - sp * z, sp * y + cp * z                  # roll about x
     x2, z2 = ct * x + st * z1, -st * x + ct * z1                # pitch about y
     return np.column_stack([cs * x2 - ss * y1, ss * x2 + cs * y1, z2])   # heading about z
+
+
+def heading_rate_rps(heading_rad, time_s):
+    """dψ/dt (rad/s) of a heading that may wrap at ±π, by central differences."""
+    t = np.asarray(time_s, dtype=float)
+    if t.size < 2:
+        return np.zeros(t.size)
+    return np.gradient(np.unwrap(np.asarray(heading_rad, dtype=float)), t)
+
+
+def rotated_horizontal(u, angle_rad):
+    """The horizontal part of the directions `u` (N, 3), made unit and turned by `angle_rad`
+    (scalar or (N,), clockwise seen from above, as heading grows): (N, 2) north, east."""
+    h = u[:, :2] / np.linalg.norm(u[:, :2], axis=1)[:, None]
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    return np.column_stack([c * h[:, 0] - s * h[:, 1], s * h[:, 0] + c * h[:, 1]])
