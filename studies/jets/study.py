@@ -1,15 +1,19 @@
 """`jets`: real jet flight-test points calibrated by two methods, against a radiosonde and JMOSS.
 
 Every ``CLASS*.csv`` in `--data DIR` (a test point of the USAF Test Pilot School's export: GPS
-velocity, pitot total and static-port pressure, a total-temperature probe, GPS height; read
-through `TPS_EXPORT_MAP`, or through ``DIR/columns.toml`` when present) is calibrated by
+velocity, pitot total and static-port pressure, a total-temperature probe, GPS height, attitude
+and sideslip vane; read through `TPS_EXPORT_MAP` and `TPS_ATTITUDE_MAP`, or through
+``DIR/columns.toml`` when present) is calibrated by
 
-- output error with the Mach-dependent static error, the probe's recovery and the OAT
+- output error with the Mach-dependent static error (its 2σ with the spline's representation
+  error), the probe's recovery and the OAT, and, when the attitude is mapped, the airspeed's
+  direction with the heading/vane misalignment and the attitude's time offset as unknowns
   (`pitotcal.estimation.identification.mach_oe.identify_mach`), and
 - the self-survey (`pitotcal.estimation.survey.self_survey`),
 
 each with every sample through Mach 1. ``DIR/WB.txt``, when present, is the radiosonde: its wind
-and temperature at each point's median GPS height. ``jmoss.json`` in DIR or in the output folder
+and temperature at each point's median GPS height, and how much its own wind changes within
+±`SONDE_LAYER_FT` of it. ``jmoss.json`` in DIR or in the output folder
 (written by ``benchmarks/bench_jmoss.py --out``), when present, adds JMOSS's curve, wind and OAT.
 Nothing is per file: a new test point in DIR is calibrated the same way.
 
@@ -27,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from pitotcal.core.errors import PitotcalError
-from pitotcal.core.units import m_to_ft, mps_to_kt
+from pitotcal.core.units import ft_to_m, m_to_ft, mps_to_kt
 from pitotcal.estimation.identification.mach_oe import identify_mach, position_corrections
 from pitotcal.estimation.survey import self_survey
 from pitotcal.io.mapped_csv import ATTITUDE_KEYS, read_attitude, read_column_map, read_mapped_csv
@@ -59,6 +63,9 @@ pitch             = { column = "pitch_angle_rad",  unit = "rad" }
 true_heading      = { column = "true_heading_rad", unit = "rad" }
 sideslip          = { column = "aos_rad",          unit = "rad" }
 """
+# Half the depth of the layer over which the sounding's own wind change is reported: a sounding
+# taken tens of kilometres and minutes away may place a thin wind feature this far off.
+SONDE_LAYER_FT = 500.0
 # M_ic where the methods' curves are compared: below the transonic rise, where JMOSS's curve holds.
 COMPARE_MACH_IC = tuple(np.round(np.arange(0.55, 0.9001, 0.05), 2))
 _COLUMNS = ("point", "method", "altitude_ft", "wind_n_kt", "wind_e_kt", "wind_2sigma_kt",
@@ -86,7 +93,9 @@ def calibrate_point(path, mapping, sonde=None):
     if at is not None:
         entry["radiosonde"] = {"wind_n_kt": float(mps_to_kt(at["wind_n_mps"])),
                                "wind_e_kt": float(mps_to_kt(at["wind_e_mps"])),
-                               "temp_k": at["temp_k"], "ps_pa": at["ps_pa"]}
+                               "temp_k": at["temp_k"], "ps_pa": at["ps_pa"],
+                               "wind_spread_500ft_kt": float(mps_to_kt(sonde.wind_spread_mps(
+                                   h_m, ft_to_m(SONDE_LAYER_FT))))}
     return entry
 
 

@@ -38,6 +38,17 @@ def test_a_small_sounding_in_si(tmp_path):
         s.at(3000 * FT_TO_M)
 
 
+def test_the_wind_spread_within_a_layer(tmp_path):
+    """At 1500 ft the wind is 5 kt from 90°; the levels 500 ft away blow 10 kt east and 20 kt
+    west: 15 kt from it at most; none within 100 ft: 0."""
+    path = tmp_path / "s.txt"
+    path.write_text(SOUNDING)
+    s = read_sounding(path)
+    spread = s.wind_spread_mps(1500 * FT_TO_M, 500 * FT_TO_M) / KT_TO_MPS
+    assert spread == pytest.approx(15.0)
+    assert s.wind_spread_mps(1500 * FT_TO_M, 100 * FT_TO_M) == 0.0
+
+
 def test_not_a_sounding(tmp_path):
     path = tmp_path / "x.txt"
     path.write_text("time_s,qc_pa\n1,2\n")

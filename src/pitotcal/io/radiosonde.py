@@ -46,6 +46,17 @@ class Sounding:
                 "temp_k": float(np.interp(alt_m, self.alt_m, self.temp_k)),
                 "ps_pa": float(np.exp(np.interp(alt_m, self.alt_m, np.log(self.ps_pa))))}
 
+    def wind_spread_mps(self, alt_m, half_layer_m):
+        """The largest change of the wind vector from its value at `alt_m` over the sounding's
+        levels within ±`half_layer_m` (m/s; 0 with none): how far the sounding itself moves
+        within a layer of that depth, e.g. where a thin wind maximum lies."""
+        here = self.at(alt_m)
+        near = np.abs(self.alt_m - float(alt_m)) <= float(half_layer_m)
+        if not np.any(near):
+            return 0.0
+        return float(np.max(np.hypot(self.wind_n_mps[near] - here["wind_n_mps"],
+                                     self.wind_e_mps[near] - here["wind_e_mps"])))
+
 
 def read_sounding(path):
     """Read a radiosonde text file (module notes).
