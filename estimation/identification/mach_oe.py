@@ -225,7 +225,7 @@ def identify_mach(flight, *, knots=None, recovery_bounds=RECOVERY_BOUNDS, attitu
     return dataclasses.replace(result, spe=_table(result, data))
 
 
-def _solve(data, knots, start, r_bounds, weights, passes):
+def _solve(data, knots, start, r_bounds, weights, passes, ftol=1e-8):
     """Bounded least squares from `start`; each pass reweights the outputs by the residual RMS
     it leaves. (x, the last solver result, the outputs' RMS at x, the unknowns' scales)."""
     data = {**data, "basis": mach_spline_basis(data["mach_ic"], knots)}
@@ -238,7 +238,8 @@ def _solve(data, knots, start, r_bounds, weights, passes):
     x = start
     for _ in range(passes):
         sol = least_squares(_residual, x / scale, args=(data, scale, weights),
-                            bounds=(lower / scale, upper / scale), method="trf", x_scale=1.0)
+                            bounds=(lower / scale, upper / scale), method="trf", x_scale=1.0,
+                            ftol=ftol)
         x = sol.x * scale
         weights = tuple(float(np.sqrt(np.mean(r ** 2))) for r in _outputs(x, data))
     return x, sol, weights, scale
@@ -254,7 +255,8 @@ def _spline_sigma(data, knots, x, cov, r_bounds, weights):
     if dense.size == k:
         return np.zeros(k - 1)
     start = np.r_[mach_spline_basis(dense, knots) @ x[:k], x[k:]]
-    xd, sol, _, scale = _solve(data, dense, start, r_bounds, weights, passes=1)
+    # from the coarse solution; a looser tolerance: the difference is wanted to ~1e-4
+    xd, sol, _, scale = _solve(data, dense, start, r_bounds, weights, passes=1, ftol=1e-6)
     kd = dense.size
     cov_d = colored_covariance(sol.jac, sol.fun, window="exponential").covariance[:kd, :kd] \
         * np.outer(scale[:kd], scale[:kd])
