@@ -155,6 +155,29 @@ class MachFitResult:
             var = var + self.spline_sigma[_interval(m, self.knots)] ** 2
         return basis @ self.dpp_ps_knots, 2.0 * np.sqrt(np.maximum(var, 0.0))
 
+    def summary(self):
+        """A few lines in knots, kelvin and degrees, and the curve every 0.05 of M_ic."""
+        w2 = mps_to_kt(2.0 * max(self.std("wind_n_mps"), self.std("wind_e_mps")))
+        lines = [f"Mach-dependent output error: {self.n_fit} samples through M_ic "
+                 f"{self.mach_ic_max:.3f} ({'converged' if self.success else self.message})",
+                 f"Wind: {mps_to_kt(self.wind_n_mps):.1f} kt north, "
+                 f"{mps_to_kt(self.wind_e_mps):.1f} kt east (2-sigma {w2:.1f} kt)",
+                 f"OAT {self.oat_k:.2f} K (2-sigma {2 * self.std('oat_k'):.2f}); probe recovery "
+                 f"{self.recovery:.3f} (2-sigma {2 * self.std('recovery'):.3f})"
+                 + (" at its bound" if self.recovery_at_bound else "")]
+        if self.airspeed_model == "vector":
+            lines.append(f"Airspeed direction: misalignment {np.degrees(self.misalignment_rad):.2f}"
+                         f" deg (2-sigma {np.degrees(2 * self.std('misalignment_rad')):.2f}), "
+                         f"attitude time offset {self.latency_s:+.2f} s (2-sigma "
+                         f"{2 * self.std('latency_s'):.2f})")
+        lines.append("  M_ic  dpp/ps   2-sigma (spline)  dV_pc kt  dM_pc   dH_pc ft")
+        for s in self.spe:
+            if abs(s["mach_ic"] * 20.0 - round(s["mach_ic"] * 20.0)) < 1e-6:
+                lines.append(f"  {s['mach_ic']:.2f}  {s['dpp_ps']:7.4f}  {s['dpp_ps_2sigma']:.4f} "
+                             f"({s['dpp_ps_spline_2sigma']:.4f})  {s['dv_kt']:+7.1f}  "
+                             f"{s['dm']:+.4f}  {s['dh_ft']:+7.0f}")
+        return "\n".join(lines)
+
     def to_dict(self):
         """The JSON-ready summary."""
         return {"method": "output_error_mach", "success": self.success, "message": self.message,

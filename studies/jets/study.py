@@ -34,7 +34,7 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.units import ft_to_m, m_to_ft, mps_to_kt
 from pitotcal.estimation.identification.mach_oe import identify_mach, position_corrections
 from pitotcal.estimation.survey import self_survey
-from pitotcal.io.mapped_csv import ATTITUDE_KEYS, read_attitude, read_column_map, read_mapped_csv
+from pitotcal.io.mapped_csv import mapped_attitude, read_mapped_csv
 from pitotcal.io.radiosonde import read_sounding
 
 from ..engine.runner import RunsInterrupted
@@ -81,7 +81,7 @@ def calibrate_point(path, mapping, sonde=None):
     h_m = float(np.median(flight.alt_m))
     at = sonde.at(h_m) if sonde is not None else None
     start = time.perf_counter()
-    oe = identify_mach(flight, attitude=_attitude(path, mapping))
+    oe = identify_mach(flight, attitude=mapped_attitude(path, mapping))
     oe_s = time.perf_counter() - start
     start = time.perf_counter()
     ss = self_survey(flight)
@@ -97,14 +97,6 @@ def calibrate_point(path, mapping, sonde=None):
                                "wind_spread_500ft_kt": float(mps_to_kt(sonde.wind_spread_mps(
                                    h_m, ft_to_m(SONDE_LAYER_FT))))}
     return entry
-
-
-def _attitude(path, mapping):
-    """The export's attitude when the mapping names roll, pitch and true heading, else None."""
-    keys = mapping if isinstance(mapping, dict) else read_column_map(mapping)
-    if not all(k in keys for k in ATTITUDE_KEYS[:3]):
-        return None
-    return read_attitude(path, mapping)
 
 
 def _with_corrections(d, psi_pa):

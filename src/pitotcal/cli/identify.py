@@ -11,7 +11,9 @@ from pathlib import Path
 
 from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
 
-MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
+# the Mach-dependent static error of a jet (estimation.identification.mach_oe), not a MODELS entry
+MACH_SPLINE = "mach-spline"
+MODEL_CHOICES = ("inverse", "constant", "linear", "auto", MACH_SPLINE)
 # the default first, as --help and the error list them
 AIR_CHOICES = (DEFAULT_AIR_DATA, *(m for m in AIR_DATA_MODES if m != DEFAULT_AIR_DATA))
 
@@ -30,7 +32,9 @@ def add_parser(subparsers):
                         "or ps_pa + oat_k) or a .ulg/.bin/.log autopilot log")
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
-                        "information criterion and list all candidates); default %(default)s")
+                        "information criterion and list all candidates); mach-spline: a jet's "
+                        "static error as a spline in M_ic through Mach 1, with the probe's "
+                        "recovery and the OAT (docs/interfaces.md 3); default %(default)s")
     # --- air data ---
     p.add_argument("--air", default=DEFAULT_AIR_DATA, metavar="MODE",
                    help="how impact pressure follows from true airspeed: compressible "
@@ -263,9 +267,11 @@ def run(args):
     from pitotcal.io import is_log_file
     from pitotcal.io.jsonfile import write_json
 
-    choice("model", args.model, [*MODELS, "auto"])
+    choice("model", args.model, [*MODELS, "auto", MACH_SPLINE])
     choice("air", args.air, AIR_CHOICES)
     source = Path(args.flight)
+    if args.model == MACH_SPLINE:
+        return _run_mach_spline(args, source)
     plot_path = _checked_outputs(args, source)
     sensors = _sensor_options(args)
     inputs = None if args.no_budget else _budget_inputs(args, sensors)
@@ -310,6 +316,28 @@ def run(args):
         raise refused
     if params is not None:
         _print_params(params, args.params)
+    return 0
+
+
+def _run_mach_spline(args, source):
+    """`--model mach-spline`: `identify_mach` on the flight (the attitude when --columns maps
+    it); --json writes its record. No figure, budget or autopilot parameter."""
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.identification.mach_oe import identify_mach
+    from pitotcal.io.jsonfile import write_json
+    from pitotcal.io.mapped_csv import mapped_attitude
+
+    bad = [o for o, v in (("--plot", args.plot), ("--params", args.params)) if v is not None]
+    if bad:
+        raise PitotcalError(f"{bad[0]} is not made by --model {MACH_SPLINE} (`pitotcal study "
+                            "jets` draws its curve)", param="model")
+    _checked_outputs(args, source)
+    flight = _read(args, source)[0]
+    result = identify_mach(flight, attitude=args.columns and mapped_attitude(source, args.columns))
+    if args.json is not None:
+        write_json(args.json, {**result.to_dict(), "source": str(source)})
+    print(f"Flight: {source} ({flight.n} samples)\n{result.summary()}"
+          + ("" if args.json is None else f"\n\nWrote {args.json}"))
     return 0
 
 

@@ -41,7 +41,8 @@ from pitotcal.core.units import (M_PER_UNIT, MPS_PER_UNIT, PA_PER_UNIT, RAD_PER_
 from .flight_csv import read_flight_csv
 from .read_once import InputBytes, open_binary, read_once
 
-__all__ = ["ATTITUDE_KEYS", "MACH_IC_MAX", "MAPPING_KEYS", "SUPERSONIC_NOTE", "read_attitude",
+__all__ = ["ATTITUDE_KEYS", "MACH_IC_MAX", "MAPPING_KEYS", "SUPERSONIC_NOTE", "mapped_attitude",
+           "read_attitude",
            "read_column_map", "read_mapped_csv"]
 
 # mapping key -> (flight CSV column, unit table, what it is)
@@ -217,6 +218,15 @@ def read_attitude(path, columns):
         if key in mapping:
             out[MAPPING_KEYS[key][0]] = data[key] * RAD_PER_UNIT[mapping[key][1]]
     return out
+
+
+def mapped_attitude(path, columns):
+    """`read_attitude` when the mapping `columns` names roll, pitch and true_heading, else
+    None: the attitude wherever an export has it."""
+    mapping = columns if isinstance(columns, dict) else read_column_map(columns)
+    if not all(k in mapping for k in ATTITUDE_KEYS[:3]):
+        return None
+    return read_attitude(path, mapping)
 
 
 def _mapped_data(path, columns):
