@@ -36,11 +36,12 @@ on a single heading δ and the cross-track wind are one number.
 
 The spline's representation error, what knots this far apart cannot follow, is not in the
 fitted covariance. It is measured by fitting again with a knot added midway in every interval
-the data fill (`pitotcal.core.models.denser_knots`): the largest difference of the two curves
-within each of the coarse intervals is taken as a 1σ there and added in quadrature to the
-curve's variance (`spline_sigma`). For a smooth curve the denser spline's own error is an
-order smaller (a cubic spline's error falls with the fourth power of the spacing), so the
-difference measures the coarse one's.
+the data fill (`pitotcal.core.models.denser_knots`): within each coarse interval the largest
+squared difference of the two curves, less the part the denser fit's extra noise explains
+(for nested fits Var(difference) = Var(dense) − Var(coarse)), is the variance of a 1σ there,
+added to the curve's variance (`spline_sigma`). For a smooth curve the denser spline's own
+error is an order smaller (a cubic spline's error falls with the fourth power of the
+spacing), so the difference measures the coarse one's.
 """
 
 import dataclasses
