@@ -133,4 +133,6 @@ def with_reading(flight, reading):
         source = "oat_k"
     else:
         source = None                   # the density is the file's rho_kgm3
-    return dataclasses.replace(flight, reading={**reading, "oat_source": source})
+    # the reader's own record (a log's chosen windows and cuts) stays
+    return dataclasses.replace(flight, reading={**(flight.reading or {}), **reading,
+                                                "oat_source": source})
