@@ -45,6 +45,15 @@ def add_parser(subparsers):
     p.add_argument("--plot", metavar="OUT.png", default=None,
                    help="write the calibration figure (format from the extension)")
     add_reading_arguments(p)
+    p.add_argument("--oat-ground-c", type=float, default=None, metavar="DEGC",
+                   help="logs only: the ground temperature at the take-off point, degC, carried "
+                        "up the standard lapse (6.5 K/km above the take-off point) for the "
+                        "density, when no outside air temperature is logged or given (--oat-c)")
+    p.add_argument("--windows", default="auto", choices=("auto", "all"),
+                   help="logs without --start-s/--end-s: auto chooses the calibration "
+                        "windows from the log (steady, airborne flight whose track turns; "
+                        "the JSON's windows and cut_s say which and why), all keeps every "
+                        "usable sample; default %(default)s")
     p.add_argument("--columns", metavar="MAP.toml", default=None,
                    help="read FLIGHT as any CSV export through this column mapping (TOML: "
                         "which column is time, GPS velocity, total or impact pressure, static "
@@ -296,6 +305,7 @@ def run(args):
     cut = "samples cut" if is_log_file(source) else "rows dropped"
     print(f"Flight: {source} ({flight.n} samples, {flight.time_s[0]:.1f}-{flight.time_s[-1]:.1f} s"
           + (f", {flight.n_dropped} {cut}" if flight.n_dropped else "") + ")")
+    _print_windows(flight)
     print(result.summary())
     if budget is not None:
         print("\n" + budget_summary(result, budget))
@@ -311,6 +321,15 @@ def run(args):
     if params is not None:
         _print_params(params, args.params)
     return 0
+
+
+def _print_windows(flight):
+    """The windows chosen from a whole-flight log, and what was cut, one line each."""
+    from pitotcal.io.windows import windows_text
+
+    text = windows_text(flight.reading)
+    if text:
+        print("\n".join(f"  {line}" for line in text.splitlines()))
 
 
 def _checked_outputs(args, source):
@@ -330,7 +349,9 @@ def _read(args, source):
     from pitotcal.io import read_flight
 
     air = {"oat_k": oat_k_from_c(args.oat_c), "temp_recovery": args.temp_recovery,
-           "rh_pct": args.rh_percent}
+           "rh_pct": args.rh_percent, "windows": args.windows}
+    if args.oat_ground_c is not None:
+        air["oat_ground_k"] = oat_k_from_c(args.oat_ground_c, "--oat-ground-c")
     if args.params is None:
         return read_flight(source, start_s=args.start_s, end_s=args.end_s,
                            columns=getattr(args, "columns", None), **air), None, {}

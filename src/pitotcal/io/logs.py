@@ -126,7 +126,7 @@ def read_log(path, start_s=None, end_s=None, **options):
 
 def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_latency_s=0.0,
              min_groundspeed_mps=5.0, min_qci_pa=QCI_MIN_FLYING_PA, oat_k=None,
-             min_airspeed_mps=None, oat_ground_k=None, windows="auto"):
+             min_airspeed_mps=None, oat_ground_k=None, windows="all"):
     """Read a log as a `FlightLog`: the `Flight` and the autopilot's own estimates.
 
     Parameters
@@ -153,11 +153,12 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     oat_ground_k : float, optional
         The ground temperature at the take-off point, K, carried up the standard lapse
         (`pitotcal.io.oat`); with `oat_k` the latter wins.
-    windows : {"auto", "all"}
-        Without `start_s` and `end_s`: "auto" keeps the steady flight and chooses the
-        calibration windows from the log (`pitotcal.io.windows`; several windows set
-        `Flight.segment`, and `Flight.reading` gets ``windows`` and ``cut_s``); "all" keeps
-        every usable sample as one window. A given window is always used as it is.
+    windows : {"all", "auto"}
+        "all" (default) keeps every usable sample as one window; "auto", without `start_s`
+        and `end_s`, keeps the steady flight and chooses the calibration windows from the log
+        (`pitotcal.io.windows`; several windows set `Flight.segment`, and `Flight.reading`
+        gets ``windows`` and ``cut_s``), as `pitotcal identify` does. A given window is always
+        used as it is.
 
     Returns
     -------
@@ -183,7 +184,7 @@ class _Options(NamedTuple):
 
 
 def _check_options(gps_resample, gps_latency_s, min_groundspeed_mps, min_qci_pa, oat_k,
-                   min_airspeed_mps, oat_ground_k=None, windows="auto"):
+                   min_airspeed_mps, oat_ground_k=None, windows="all"):
     """The reader's options, checked (a `PitotcalError` naming the parameter)."""
     if gps_resample not in _GPS_RESAMPLE:
         raise PitotcalError(f"gps_resample {gps_resample!r} is not one of "

@@ -43,7 +43,7 @@ __all__ = ["FULL_THROTTLE", "JOIN_GAP_S", "MAX_BANK_DEG", "MAX_IAS_RATE_MPS2",
 SMOOTH_S = 2.0
 PAD_S = 2.0
 MAX_PATH_ANGLE_DEG = 15.0
-MAX_BANK_DEG = 45.0
+MAX_BANK_DEG = 50.0     # above the autopilots' default bank limits (ArduPlane 45 deg)
 MAX_IAS_RATE_MPS2 = 2.0
 STALL_MARGIN = 0.9
 FULL_THROTTLE = 0.95
@@ -146,8 +146,9 @@ def choose_windows(t, keep, vn_mps, ve_mps):
         elif spread <= MIN_TRACK_SPREAD_DEG:
             no_turn |= mask
         else:
-            windows.append(_window(t, mask, spread, "steady, airborne, track turns "
-                                   f"{spread:.0f} deg (> {MIN_TRACK_SPREAD_DEG:g})"))
+            windows.append(_window(t, mask, spread, "steady and airborne, at least "
+                                   f"{MIN_WINDOW_S:g} s, track turns more than "
+                                   f"{MIN_TRACK_SPREAD_DEG:g} deg"))
     if not windows and (too_short | no_turn).any():
         mask = too_short | no_turn
         spread = track_spread_deg(vn_mps[mask], ve_mps[mask])
