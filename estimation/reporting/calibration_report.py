@@ -340,6 +340,8 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
         # what identify recorded ("reading"), overridden by what the report was told
         opts = {k: v for src in (result.get("reading") or {}, flight_options or {})
                 for k, v in src.items() if v is not None and k in _READING_OPTIONS}
+        if result.get("windows") and opts.get("start_s") is None and opts.get("end_s") is None:
+            opts["windows"] = "auto"        # the windows identify chose from the log, again
         # the same reading and air data, then identify's air-data mode: the same fit
         flight = read_flight(flight_path, **opts)
         stated = result.get("gps_error") or {}

@@ -3,60 +3,12 @@ outside air temperature's source (pitotcal.io.oat), on simulated DataFlash logs 
 
 import numpy as np
 import pytest
-from logwriters import PS_PA, write_dataflash_bin
-from synthetic import synthetic_flight, wind_vector
+from wholeflight import K, OAT_K, calibration as _calibration, straight as _straight
+from wholeflight import write_log as _log
 
-from pitotcal.core.flight import Flight
-from pitotcal.core.models import get_model, qci_from_qc_pa
-from pitotcal.core.units import R_AIR_JKGK
 from pitotcal.estimation import identify
 from pitotcal.io import read_flight
 from pitotcal.io.logs import load_log
-
-RATE_HZ, RHO, K = 10.0, 1.196, (0.02, -15.0)
-WIND = wind_vector(5.0, 270.0)
-
-
-def _straight(duration_s, tas_mps, path_deg, heading_deg=90.0):
-    """(qci, vn, ve, vd) of straight flight at this true airspeed and flight-path angle."""
-    n = int(duration_s * RATE_HZ)
-    vd = np.full(n, -tas_mps * np.sin(np.radians(path_deg)))
-    vh = tas_mps * np.cos(np.radians(path_deg))
-    vn = np.full(n, vh * np.cos(np.radians(heading_deg)) + WIND[0])
-    ve = np.full(n, vh * np.sin(np.radians(heading_deg)) + WIND[1])
-    qci = qci_from_qc_pa(get_model("inverse"), K, np.full(n, 0.5 * RHO * tas_mps ** 2))
-    return qci, vn, ve, vd
-
-
-def _calibration(duration_s, seed):
-    f, _ = synthetic_flight(seed=seed, n=int(duration_s * RATE_HZ), rate_hz=RATE_HZ, k=K,
-                            cas_kt=(60.0, 90.0), turns=duration_s / 100.0, rho_kgm3=RHO)
-    return f.qci_pa, f.gps_vn_mps, f.gps_ve_mps, np.zeros(f.n)
-
-
-def _whole_flight(parts):
-    """A Flight of the parts [(name, (qci, vn, ve, vd))] one after another, and each part's
-    (start, end) time, s."""
-    cols = [np.concatenate([p[1][i] for p in parts]) for i in range(4)]
-    t = np.arange(cols[0].size) / RATE_HZ
-    spans, i = {}, 0
-    for name, p in parts:
-        spans.setdefault(name, []).append((t[i], t[i + p[0].size - 1]))
-        i += p[0].size
-    flight = Flight(time_s=t, qci_pa=cols[0], gps_vn_mps=cols[1], gps_ve_mps=cols[2],
-                    rho_kgm3=np.full(t.size, RHO), gps_vd_mps=cols[3])
-    return flight, spans
-
-
-def _log(tmp_path, parts):
-    flight, spans = _whole_flight(parts)
-    ground = spans["ground"]
-    path = write_dataflash_bin(tmp_path / "whole.bin", flight, flying=(ground[0][1], ground[1][0]),
-                               min_airspeed=15.0)
-    return path, spans
-
-
-OAT_K = PS_PA / (R_AIR_JKGK * RHO)        # the temperature the test logs carry
 
 
 def test_the_windows_are_the_calibration_part_and_the_fit_matches_the_truth(tmp_path):
@@ -121,3 +73,59 @@ def test_oat_from_the_ground_temperature_and_the_lapse(tmp_path):
     assert "standard lapse" in flight.reading["oat_source"]
     from pitotcal.estimation.identification.sensor_inputs import detected_oat_source
     assert detected_oat_source(flight)[0] == "ground-lapse"
+
+
+def test_a_logged_oat_sensor_is_the_temperature_and_a_flag_wins_over_it(tmp_path):
+    """ArduPilot TEMP (a temperature sensor): the density's temperature, no chip warning; with
+    oat_k given the flag wins and the sensor's reading is noted."""
+    import warnings
+
+    path, _ = _log(tmp_path, [("ground", _straight(20, 3.0, 0.0)),
+                              ("cal", _calibration(120, seed=7)),
+                              ("ground", _straight(20, 3.0, 0.0))], oat_sensor_c=3.5)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        flight = read_flight(path)
+    assert np.allclose(flight.oat_k, 276.65)
+    assert flight.reading["oat_source"] == ("TEMP.Temp (temperature sensor): a logged outside "
+                                            "air temperature")
+    assert not any("not OAT" in str(w.message) for w in caught)
+    with pytest.warns(UserWarning, match=r"TEMP\.Temp \(temperature sensor\) \(mean 3\.5 degC\) "
+                                         r"not used: `oat_k` given"):
+        given = read_flight(path, oat_k=290.0)
+    assert np.allclose(given.oat_k, 290.0)
+
+
+def test_full_throttle_is_cut_where_the_log_has_the_throttle(tmp_path):
+    """A 10-deg climb (steady by its angle) at full throttle (CTUN.ThO 100 %) is cut for the
+    throttle; at 70 % it is kept."""
+    parts = [("ground", _straight(20, 3.0, 0.0)), ("climb", _straight(40, 35.0, 10.0)),
+             ("cal", _calibration(200, seed=8)), ("ground", _straight(20, 3.0, 0.0))]
+    from wholeflight import whole_flight
+    flight, spans = whole_flight(parts)
+    (c0, c1), = spans["climb"]
+    thr = np.where((flight.time_s >= c0) & (flight.time_s <= c1), 100.0, 70.0)
+    path, _ = _log(tmp_path, parts, throttle_pct=thr)
+    read = read_flight(path, oat_k=OAT_K, windows="auto")
+    assert read.reading["cut_s"]["full throttle (CTUN.ThO >= 95 %)"] == pytest.approx(40, abs=3)
+    assert read.time_s.min() > c1
+    path, _ = _log(tmp_path, parts, throttle_pct=np.full(flight.n, 70.0))
+    assert read_flight(path, oat_k=OAT_K, windows="auto").time_s.min() < c1
+
+
+def test_the_ground_lapse_follows_the_height_above_the_take_off_point():
+    """T = T_ground - 6.5 K/km above the take-off point, the height from the static pressure."""
+    from pitotcal.core.units import isa_pressure_pa
+    from pitotcal.io.oat import oat_on_times, takeoff_height_m
+    from pitotcal.io.streams import LogStreams
+
+    t = np.arange(0.0, 100.0, 0.5)
+    h = np.where(t < 20.0, 300.0, 1300.0)          # on the ground at 300 m, then 1 km up
+    s = LogStreams(static_t=t, ps_pa=isa_pressure_pa(h), airborne_t=np.array([0.0, 20.0]),
+                   airborne=np.array([False, True]))
+    assert takeoff_height_m(s) == pytest.approx(300.0, abs=0.5)
+    temp, source = oat_on_times(s, t, np.full(t.size, 500.0), isa_pressure_pa(h), h,
+                                oat_ground_k=288.15)
+    assert temp[t >= 20.0] == pytest.approx(288.15 - 6.5, abs=0.01)
+    assert temp[t < 20.0] == pytest.approx(288.15, abs=0.01)
+    assert "standard lapse from the ground" in source and "(300 m)" in source
