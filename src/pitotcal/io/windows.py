@@ -16,7 +16,8 @@ sides, so the transition into and out of it goes too):
 - rapid airspeed change: |dIAS/dt| beyond `MAX_IAS_RATE_MPS2`: the tubing's pneumatic lag and
   unsteady flow, not the steady pressure error;
 - near stall: IAS below `STALL_MARGIN` times the autopilot's minimum airspeed parameter;
-- full throttle, where the log has the throttle (ArduPilot ``CTUN.ThO``): at or above
+- full throttle, where the log has the throttle (ArduPilot ``CTUN.ThO``; PX4
+  ``vehicle_thrust_setpoint.xyz[0]`` or ``actuator_controls_0.control[3]``): at or above
   `FULL_THROTTLE` the propeller wash over a nose or wing pitot is at its strongest.
 
 Windows: runs of steady samples shorter than `MIN_RUN_S` are cut; runs closer than
