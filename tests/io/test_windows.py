@@ -129,3 +129,22 @@ def test_the_ground_lapse_follows_the_height_above_the_take_off_point():
     assert temp[t >= 20.0] == pytest.approx(288.15 - 6.5, abs=0.01)
     assert temp[t < 20.0] == pytest.approx(288.15, abs=0.01)
     assert "standard lapse from the ground" in source and "(300 m)" in source
+
+
+def test_no_window_long_enough_alone_keeps_all_steady_flight_with_a_warning(tmp_path):
+    """Two 45-s calibration parts 40 s apart (a dive between): neither is a window alone
+    (60 s), so all steady flight is one window, and a warning says so."""
+    path, spans = _log(tmp_path, [("ground", _straight(20, 3.0, 0.0)),
+                                  ("cal", _calibration(45, seed=10)),
+                                  ("dive", _straight(40, 45.0, -30.0)),
+                                  ("cal", _calibration(45, seed=11)),
+                                  ("ground", _straight(20, 3.0, 0.0))])
+    with pytest.warns(UserWarning, match="no steady window alone is long enough and turns "
+                                         "enough: .*all steady flight is fitted as one window"):
+        flight = read_flight(path, oat_k=OAT_K, windows="auto")
+    (w,) = flight.reading["windows"]
+    assert w["reason"].startswith("all steady flight as one window")
+    assert flight.segment is None
+    (a0, a1), (b0, b1) = spans["cal"]
+    assert w["start_s"] < a0 + 5 and w["end_s"] > b1 - 5
+    assert not np.any((flight.time_s > a1 + 1) & (flight.time_s < b0 - 1))   # the dive: cut
