@@ -36,16 +36,18 @@ What is cut (an INFO log line names every cut with its sample count and time spa
       or ``vel_ned_valid == 0``, ArduPilot ``Status < 3``) or a gap between fixes;
     - on the ground or too slow to calibrate: GPS ground speed below `min_groundspeed_mps`
       (5 m/s) or q_ci below `min_qci_pa` (20 Pa, ~11 kt; the flight CSV reader's threshold);
-    - non-finite values, and repeated time stamps of the pressure stream.
+    - non-finite values, and repeated time stamps of the pressure stream;
+    - with ``windows="auto"`` and no window given: what is not steady flight, and what no
+      calibration window holds (`pitotcal.io.windows`).
     Fewer than `MIN_SAMPLES` samples or `MIN_DURATION_S` seconds left is a `FlightDataError`.
 
 Density
-    rho = ps / (R T) with the log's static pressure and a temperature. Neither autopilot logs
-    the outside air temperature: the reader takes the airspeed sensor's temperature where it
-    has one, else the barometer's, and warns that it is the sensor's, not OAT: a sensor 15 K
-    warmer than the air gives a density 5 % low, which the pressure-error model absorbs into
-    k1. Pass `oat_k` (a measured outside air temperature, K) to use it instead. A log without
-    static pressure uses the ISA atmosphere at the GPS altitude, with a warning.
+    rho = ps / (R T) with the log's static pressure and a temperature from the best source
+    the log and the caller have (`pitotcal.io.oat`): `oat_k`, `oat_ground_k` with the standard
+    lapse, a logged OAT sensor, else a pressure chip's own temperature with a warning giving
+    its distance from ISA and what it does to ΔV (a sensor 15 K warmer than the air gives a
+    density 5 % low, which the pressure-error model absorbs into k1). A log without static
+    pressure uses the ISA atmosphere at the GPS altitude, with a warning.
 
 The autopilot's own estimates
     Kept out of the `Flight`'s arrays: `FlightLog.autopilot_wind` is the wind-estimate series
