@@ -39,13 +39,14 @@ def _inside(t, span):
 
 def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", ratio=2.0,
                       old=False, gps_invalid=None, airspeed_only=False, flying=None,
-                      min_airspeed=None):
+                      min_airspeed=None, oat_sensor_c=None, throttle_pct=None):
     """(formats, rows) of an ArduPilot log of `flight`: formats {name: (id, fmt, columns)}.
 
     `old`: ms time stamps (``TimeMS``), GPS velocity as VelN/VelE; `airspeed_only`: ARSP has
     Airspeed (EAS = sqrt(ratio * dp)) but no DiffPress, as some firmware logs it. `flying`:
     (t0, t1) of the flight's time_s when STAT (5 Hz) says isFlying and Armed (no STAT when
-    None); `min_airspeed`: the ARSPD_FBW_MIN parameter, m/s.
+    None); `min_airspeed`: the ARSPD_FBW_MIN parameter, m/s. `oat_sensor_c`: a temperature
+    sensor's TEMP messages (1 Hz, degC); `throttle_pct`: CTUN.ThO per sample (5 Hz), %.
     """
     t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
     time_col, tscale, tfmt = ("TimeMS", 1e-3, "I") if old else ("TimeUS", 1.0, "Q")
@@ -67,6 +68,10 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
     }
     if flying is not None:
         formats["STAT"] = (5, tfmt + "BB", f"{time_col},isFlying,Armed")
+    if oat_sensor_c is not None:
+        formats["TEMP"] = (6, tfmt + "Bf", f"{time_col},Instance,Temp")
+    if throttle_pct is not None:
+        formats["CTUN"] = (7, tfmt + "f", f"{time_col},ThO")
     rows = [(0, "PARM", [int(t_us[0]) - 1000, "ARSPD_RATIO", ratio]),
             (0, "PARM", [int(t_us[0]) - 1000, "ARSPD_TYPE", 1.0]),
             (0, "MSG", [stamp(0), firmware])]
@@ -84,6 +89,10 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
             rows.append((t_us[i], "NKF2", [stamp(i), 0, -1.0, 0.5]))
         if flying is not None and i % 2 == 0:
             rows.append((t_us[i], "STAT", [stamp(i), int(in_flight[i]), int(in_flight[i])]))
+        if oat_sensor_c is not None and i % 10 == 0:
+            rows.append((t_us[i], "TEMP", [stamp(i), 0, float(oat_sensor_c)]))
+        if throttle_pct is not None and i % 2 == 0:
+            rows.append((t_us[i], "CTUN", [stamp(i), float(throttle_pct[i])]))
     idx, status = _gps_rows(flight, gps_every, gps_invalid)
     vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(flight.n)
     for i, st in zip(idx, status):

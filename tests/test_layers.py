@@ -162,7 +162,10 @@ def test_a_command_never_imports_another_command(graph):
     shared = {"pitotcal.cli", "pitotcal.cli.common"}
     commands = {n for n in graph if n.startswith("pitotcal.cli.") and n not in shared}
     assert "pitotcal.cli.common" in graph["pitotcal.cli.identify"]
-    assert {n: sorted(graph[n] & commands) for n in commands if graph[n] & commands} == {}
+    # a command's own part (`identify_budget` of `identify`) is no command of its own
+    wrong = {n: sorted(t for t in graph[n] & commands if not t.startswith(n + "_"))
+             for n in commands}
+    assert {n: t for n, t in wrong.items() if t} == {}
 
 
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from pitotcal.core import checks
 from pitotcal.core.errors import FlightDataError, ObservabilityError, PitotcalError
+from pitotcal.core.flight import MIN_TRACK_SPREAD_DEG, track_spread_deg
 from pitotcal.core.measurement import AIR_DATA_MODES, DEFAULT_AIR_DATA
 from pitotcal.core.models import MODELS, get_model
 from pitotcal.core.scenario import GPS_NOISE_MAX_MPS
@@ -27,9 +28,6 @@ __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_D
 log = logging.getLogger(__name__)
 
 MIN_SAMPLES = 50
-# Wind and calibration separate only if the track turns: up to half a circle (an out-and-back
-# line included) the wind across the track is indistinguishable from a scale error.
-MIN_TRACK_SPREAD_DEG = 180.0
 # k1 and the second coefficient separate only over a spread of q_ci: (q98 - q2) / median.
 MIN_QCI_SPAN = 0.05
 # Above this |correlation| (plain information matrix) two parameters are not separable.
@@ -297,16 +295,6 @@ def _check_flight(flight, air_data="incompressible"):
         if name in air and np.any(values <= 0):
             raise FlightDataError(f"{flight.source}: {name}, row "
                                   f"{int(np.argmax(values <= 0)) + 1}: not positive")
-
-
-def track_spread_deg(vn_mps, ve_mps):
-    """Angular spread of the ground track, degrees: 360 minus the largest empty arc of courses."""
-    moving = np.hypot(vn_mps, ve_mps) > 1.0
-    if moving.sum() < 2:
-        return 0.0
-    course = np.sort(np.degrees(np.arctan2(ve_mps[moving], vn_mps[moving])) % 360.0)
-    gaps = np.diff(np.concatenate([course, [course[0] + 360.0]]))
-    return float(360.0 - gaps.max())
 
 
 def _check_track(flight):

@@ -30,7 +30,8 @@ def to_dict(result):
         dv_U_kt when there is a budget), noise_std_pa, gps_noise_std_mps, candidates,
         criterion, timing_s, air_data, consistency (when it ran), static_source (compressible),
         source, n_dropped, uncertainty_budget (with a budget), noise_model (absent for a record
-        too short for it), gps_error, reading.
+        too short for it), gps_error, reading; windows and cut_s when the windows were
+        chosen from a whole-flight log (`pitotcal.io.windows`).
     """
     from .view import correction_table
 
@@ -70,7 +71,10 @@ def to_dict(result):
         out = with_budget(out, result.budget)
     if result.monitor_noise is not None:       # absent for a record too short for it
         out["noise_model"] = result.monitor_noise
-    out.update(gps_error=result.gps_error, reading=result.reading)
+    reading = dict(result.reading) if result.reading is not None else None
+    if reading and reading.get("windows"):      # the windows chosen from a whole-flight log
+        out.update(windows=reading.pop("windows"), cut_s=reading.pop("cut_s", {}))
+    out.update(gps_error=result.gps_error, reading=reading)
     return json_ready(out)
 
 

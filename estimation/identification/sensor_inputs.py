@@ -41,6 +41,7 @@ import numpy as np
 
 from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
+from pitotcal.io.oat import GROUND_LAPSE_SOURCE
 
 __all__ = ["CLASS_DEFAULTS", "DEFAULT_SENSOR_CLASS", "OAT_SOURCES", "SENSOR_CLASSES",
            "SENSOR_TOML_KEYS", "BudgetInputs", "detected_oat_source", "inputs_from_table",
@@ -156,6 +157,8 @@ def detected_oat_source(flight):
             return "total-temperature", "tat_k"
         return "probe", "oat_k" if flight.oat_k is not None else "the flight's rho_kgm3"
     text = str(text)
+    if GROUND_LAPSE_SOURCE in text:
+        return "ground-lapse", text
     if "given by the user" in text:
         return "user", text
     if "sensor temperature" in text:

@@ -164,6 +164,16 @@ def _conditions(result, flight):
         for key in ("oat_source", "temperature_source", "autopilot", "firmware"):
             if key in flight.meta:
                 rows.append((key.replace("_", " ").capitalize(), str(flight.meta[key])))
+    oat = (result.get("reading") or {}).get("oat_source")
+    if oat and (flight is None or "temperature_source" not in flight.meta):
+        rows.append(("Temperature source", str(oat)))
+    if result.get("windows"):
+        from pitotcal.io.windows import windows_text
+
+        lines = windows_text(result).splitlines()
+        rows.append(("Calibration windows", "; ".join(line for line in lines
+                                                      if not line.startswith("cut: "))))
+        rows += [("Cut from the log", line[5:]) for line in lines if line.startswith("cut: ")]
     if result.get("source"):
         rows.append(("Result source", str(result["source"])))
     return rows
@@ -298,7 +308,7 @@ def read_result(path):
 
 
 # the reading a result records that `read_flight` takes (its "oat_source" is a description)
-_READING_OPTIONS = ("start_s", "end_s", "oat_k", "temp_recovery", "rh_pct")
+_READING_OPTIONS = ("start_s", "end_s", "oat_k", "temp_recovery", "rh_pct", "oat_ground_k")
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
                 aircraft_path=None,
@@ -330,6 +340,8 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
         # what identify recorded ("reading"), overridden by what the report was told
         opts = {k: v for src in (result.get("reading") or {}, flight_options or {})
                 for k, v in src.items() if v is not None and k in _READING_OPTIONS}
+        if result.get("windows") and opts.get("start_s") is None and opts.get("end_s") is None:
+            opts["windows"] = "auto"        # the windows identify chose from the log, again
         # the same reading and air data, then identify's air-data mode: the same fit
         flight = read_flight(flight_path, **opts)
         stated = result.get("gps_error") or {}

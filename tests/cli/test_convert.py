@@ -40,9 +40,13 @@ def test_convert_window_and_warning_lines(tmp_path, flight, capsys):
     out = tmp_path / "w.csv"
     assert main(["convert", str(log), "-o", str(out), "--start-s", "20", "--end-s", "80"]) == 0
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["warning: f.ulg: no outside air temperature in the log: density uses "
-                   "differential_pressure.temperature (airspeed sensor), a sensor temperature, "
-                   "not OAT (give the outside air temperature, --oat-c)"]
+    # the warning says how far the chip is from ISA, what that does, and both flags that fix it
+    assert len(err) == 1
+    assert err[0].startswith("warning: f.ulg: no outside air temperature in the log: density "
+                             "uses differential_pressure.temperature (airspeed sensor), a sensor "
+                             "temperature, not OAT: it reads 9.4 degC, -3.2 K from ISA")
+    assert err[0].endswith("give the outside air temperature (--oat-c) or the ground "
+                           "temperature at take-off (--oat-ground-c)")
     t = read_flight_csv(out).time_s
     assert t[0] >= 20.0 and t[-1] <= 80.0 and t.size == pytest.approx(600, abs=2)
 
@@ -88,17 +92,28 @@ def test_identify_reads_the_sitl_log_directly(shared_file, tmp_path, capsys):
     assert main(["identify", str(log), "--model", "constant", "--json", str(out)]) == 0
     result = json.loads(out.read_text())
     assert result["converged"] and result["parameters"]["wind_speed_mps"]["value"] < 1.0
+    # the chip's 34.9 degC is 20 K above ISA: 7 % in density, 1.3 kt in dV at the median IAS
     warning = ("arduplane_sitl.log: no outside air temperature in the log: density uses "
-               "BARO.Temp (baro sensor), a sensor temperature, not OAT (give the outside air "
-               "temperature, `oat_k`)")
+               "BARO.Temp (baro sensor), a sensor temperature, not OAT: it reads 34.9 degC, "
+               "+20.1 K from ISA at the flight's altitude; if the air was at ISA, the density is "
+               "7.0 % low, which moves dV by 1.33 kt at the median 38 kt IAS and an airspeed "
+               "ratio by 7.0 %; give the outside air temperature (`oat_k`) or the ground "
+               "temperature at take-off (`oat_ground_k`)")
     cap = capsys.readouterr()
     # the record names the Python argument, the command line its flag
-    assert cap.err == f"warning: {warning.replace('`oat_k`', '--oat-c')}\n"
+    flags = warning.replace("`oat_k`", "--oat-c").replace("`oat_ground_k`", "--oat-ground-c")
+    assert cap.err == f"warning: {flags}\n"
     assert result["warnings"].count(warning) == 1
     # the take-off and landing rolls are cut: the table starts at the slowest flight (19 kt,
     # ARSPD_FBW_MIN = 10 m/s), not at the 11 kt of the ground roll
     assert 19.0 < result["airspeed_correction"][0]["vi_kt"] < 19.5
-    assert "(2048 samples, 15.5-220.2 s, 492 samples cut)" in cap.out.splitlines()[0]
+    # no window given: the steady, airborne flight is chosen from the log (the take-off climb
+    # and the landing descent's ends go with the rolls; 17 s of turns beyond 50 deg bank and
+    # 12 s of fast airspeed changes); it was 2048 samples, 15.5-220.2 s, 492 cut before
+    assert "(1756 samples, 35.4-215.1 s, 784 samples cut)" in cap.out.splitlines()[0]
+    assert cap.out.splitlines()[1].startswith("  window 1: 35.4-215.1 s, 1756 samples")
+    assert result["windows"][0]["n_samples"] == 1756
+    assert result["cut_s"]["steep turn (bank > 50 deg)"] == pytest.approx(16.7, abs=0.1)
 
 
 def test_identify_on_a_log_takes_the_oat(tmp_path, flight, capsys):

@@ -29,6 +29,7 @@ ALLOWED = {
     ("simulate", "--probe-arm-m"): {"-1"},               # ahead of or behind the CG
     ("identify", "--probe-arm-m"): {"-1"},
     ("convert", "--oat-c"): {"-1"},                      # a log's OAT, degC
+    ("convert", "--oat-ground-c"): {"-1"},               # a ground temperature, degC
     # a limit: a huge one is no limit (the plan converges as without it)
     ("plan", "--roll-rate-max-dps"): {"1e300"},
     ("plan", "--accel-max-mps2"): {"1e300"},

@@ -82,7 +82,7 @@ def build_parser():
 _WINDOW = re.compile(r"(?<![\w/.\\-])(start_s|end_s)(?:(=)|(?= (?:[-+]?[\d.]|must\b|is\b)))")
 # Library parameters whose flag has another name (or unit: oat_k is also a flight-CSV column,
 # so it is replaced only when the error is about it, or named in backquotes).
-_FLAG_DEST = {"oat_k": "oat_c", "gps_noise_std_mps": "gps_noise_mps", "aircraft_path": "aircraft",
+_FLAG_DEST = {"oat_k": "oat_c", "oat_ground_k": "oat_ground_c", "gps_noise_std_mps": "gps_noise_mps", "aircraft_path": "aircraft",
               "pdf_path": "pdf"}
 
 

@@ -22,12 +22,14 @@ def add_reading_arguments(parser, prefix=""):
                         help=f"{prefix}use only samples with time_s <= S")
     parser.add_argument("--oat-c", type=float, default=None, metavar="DEGC",
                         help=f"{prefix}logs only: measured outside air temperature, degC, for "
-                             "density (default: the log's airspeed or baro sensor temperature, "
-                             "with a warning); a flight CSV carries its own rho_kgm3 or oat_k")
+                             "density (default: a logged OAT sensor, else the log's airspeed or "
+                             "baro sensor temperature, with a warning); a flight CSV carries its "
+                             "own rho_kgm3 or oat_k")
 
 
-def oat_k_from_c(oat_c):
-    """--oat-c in kelvin; a PitotcalError naming the option when it is not an OAT in degC."""
+def oat_k_from_c(oat_c, flag="--oat-c"):
+    """--oat-c (or `flag`) in kelvin; a PitotcalError naming the option when it is not an OAT
+    in degC."""
     from pitotcal.core.errors import PitotcalError
 
     if oat_c is None:
@@ -36,7 +38,7 @@ def oat_k_from_c(oat_c):
     if not lo <= oat_c <= hi:
         hint = (" (looks like kelvin: give degrees Celsius, K - 273.15)"
                 if 180.0 <= oat_c <= 330.0 else "")
-        raise PitotcalError(f"--oat-c {oat_c:g}: not an outside air temperature in degC "
+        raise PitotcalError(f"{flag} {oat_c:g}: not an outside air temperature in degC "
                             f"({lo:g} to {hi:g}){hint}")
     return oat_c + 273.15
 

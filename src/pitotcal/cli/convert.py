@@ -20,6 +20,10 @@ def add_parser(subparsers):
     p.add_argument("-o", "--output", required=True, metavar="FLIGHT.csv",
                    help="flight CSV to write")
     add_reading_arguments(p)
+    p.add_argument("--oat-ground-c", type=float, default=None, metavar="DEGC",
+                   help="the ground temperature at the take-off point, degC, carried up the "
+                        "standard lapse (6.5 K/km) for the density, when no outside air "
+                        "temperature is logged or given (--oat-c)")
     p.add_argument("--gps-resample", choices=("linear", "hold"), default="linear",
                    help="GPS onto the pressure times: interpolate between fixes, or hold the "
                         "last fix (default: %(default)s)")
@@ -43,8 +47,10 @@ def run(args):
 
     src, out = Path(args.log), Path(args.output)
     check_outputs({"-o": out}, [(src, "the input log")])    # said before reading a large log
+    ground = (None if args.oat_ground_c is None
+              else oat_k_from_c(args.oat_ground_c, "--oat-ground-c"))
     flog = load_log(src, args.start_s, args.end_s, gps_resample=args.gps_resample,
-                    oat_k=oat_k_from_c(args.oat_c))
+                    oat_k=oat_k_from_c(args.oat_c), oat_ground_k=ground)
     flight = flog.flight
     write_flight_csv(flight, out, comments={"converted_by": "pitotcal convert"})
     print(f"pitotcal convert: {src.name} ({flog.autopilot}, {flog.log_format}) -> {out}: "

@@ -4,7 +4,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-__all__ = ["Flight"]
+__all__ = ["MIN_TRACK_SPREAD_DEG", "Flight", "track_spread_deg"]
+
+# Wind and calibration separate only if the track turns: up to half a circle (an out-and-back
+# line included) the wind across the track is indistinguishable from a scale error.
+MIN_TRACK_SPREAD_DEG = 180.0
 
 
 @dataclass(frozen=True)
@@ -94,3 +98,13 @@ class Flight:
 
 _ARRAYS = ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3", "gps_vd_mps", "alt_m", "ps_pa",
            "oat_k", "ps_ref_pa", "tat_k", "rh_pct", "segment")
+
+
+def track_spread_deg(vn_mps, ve_mps):
+    """Angular spread of the ground track, degrees: 360 minus the largest empty arc of courses."""
+    moving = np.hypot(vn_mps, ve_mps) > 1.0
+    if moving.sum() < 2:
+        return 0.0
+    course = np.sort(np.degrees(np.arctan2(ve_mps[moving], vn_mps[moving])) % 360.0)
+    gaps = np.diff(np.concatenate([course, [course[0] + 360.0]]))
+    return float(360.0 - gaps.max())

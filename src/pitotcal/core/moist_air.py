@@ -212,14 +212,15 @@ def with_static_air(flight, *, temp_recovery=1.0, rh_pct=None):
     ------
     PitotcalError
         `temp_recovery` outside [0, 1], `rh_pct` outside [0, 100]; a flight whose air data
-        `read_flight` has made already (its `reading` is set): read it again with the options.
+        `read_flight` has made already (its `reading` has `temp_recovery`): read it again.
     FlightDataError
         `rh_pct` given for a flight without the static pressure. (Columns `tat_k` or `rh_pct`
         without `ps_pa` are ignored with a warning, also in `Flight.warnings`: the density is
         then the file's `rho_kgm3`.)
     """
     temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
-    if flight.reading is not None:
+    # a log reader's own record (its chosen windows) is no air data made yet
+    if flight.reading is not None and "temp_recovery" in flight.reading:
         raise PitotcalError(f"{flight.source}: its air data was made when it was read "
                             f"(temp_recovery {flight.reading.get('temp_recovery')}, rh_pct "
                             f"{flight.reading.get('rh_pct')}); read it again with "

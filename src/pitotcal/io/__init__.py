@@ -40,7 +40,7 @@ def is_log_file(path):
 
 
 def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0, rh_pct=None,
-                columns=None):
+                columns=None, oat_ground_k=None, windows="all"):
     """Read a calibration flight from a flight CSV or an autopilot log.
 
     Parameters
@@ -54,6 +54,12 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
         Validation (the 1 % bad-row rule) applies inside this window only.
     oat_k : float, optional
         Logs only: a measured outside air temperature, K, for the density (see `load_log`).
+    oat_ground_k : float, optional
+        Logs only: the ground temperature at the take-off point, K, carried up the standard
+        lapse (`pitotcal.io.oat`).
+    windows : {"all", "auto"}
+        Logs only: keep every usable sample (default), or, without `start_s`/`end_s`, choose
+        the calibration windows from the log (`pitotcal.io.windows`).
     temp_recovery : float
         Recovery factor of the total-temperature probe of a `tat_k` column, 0-1:
         T_s = T_t / (1 + r 0.2 M²) (`pitotcal.core.moist_air.with_static_air`).
@@ -92,8 +98,11 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
     temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
     reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                "temp_recovery": temp_recovery, "rh_pct": rh_pct}
+    log_options = {"oat_ground_k": oat_ground_k, "windows": windows}
+    if oat_ground_k is not None:
+        reading["oat_ground_k"] = oat_ground_k
     if columns is not None:
-        if is_log_file(path) or oat_k is not None:
+        if is_log_file(path) or oat_k is not None or oat_ground_k is not None:
             raise PitotcalError(f"columns applies to CSV exports only, without oat_k; "
                                 f"{Path(path).name} is read as it is", param="columns")
         from .mapped_csv import read_mapped_csv
@@ -101,18 +110,21 @@ def read_flight(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0
                                             temp_recovery=temp_recovery, rh_pct=rh_pct),
                             {**reading, "columns": str(columns)})
     with naming(path):
-        return _read_flight(read_once(path), reading)
+        return _read_flight(read_once(path), reading, log_options)
 
 
-def _read_flight(path, reading):
+def _read_flight(path, reading, log_options):
     """`read_flight` of `path` (a file, or a stream's bytes read once) with `reading` checked."""
     start_s, end_s, oat_k = reading["start_s"], reading["end_s"], reading["oat_k"]
     temp_recovery, rh_pct = reading["temp_recovery"], reading["rh_pct"]
     if is_log_file(path) or log_suffix(path):       # a log by its name, or on a stream by its bytes
         from .logs import read_log
-        flight = read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k)
+        flight = read_log(path, start_s=start_s, end_s=end_s, oat_k=oat_k, **log_options)
         return with_reading(with_static_air(flight, temp_recovery=temp_recovery,
                                             rh_pct=rh_pct), reading)
+    if log_options["oat_ground_k"] is not None:
+        raise PitotcalError(f"oat_ground_k applies to {'/'.join(LOG_EXTENSIONS)} logs only; "
+                            f"{Path(path).name} is a flight CSV", param="oat_ground_k")
     if oat_k is not None:
         raise PitotcalError(f"oat_k applies to {'/'.join(LOG_EXTENSIONS)} logs only; "
                             f"{Path(path).name} is a flight CSV, whose density comes from its "
@@ -133,4 +145,6 @@ def with_reading(flight, reading):
         source = "oat_k"
     else:
         source = None                   # the density is the file's rho_kgm3
-    return dataclasses.replace(flight, reading={**reading, "oat_source": source})
+    # the reader's own record (a log's chosen windows and cuts) stays
+    return dataclasses.replace(flight, reading={**(flight.reading or {}), **reading,
+                                                "oat_source": source})

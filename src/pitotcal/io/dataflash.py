@@ -16,6 +16,8 @@ names of older (3.x) and newer (4.x) firmware:
 - the EKF wind estimate for comparison: ``XKF2`` (EKF3) or ``NKF2`` (EKF2), core ``C == 0``,
   else the old EKF's ``EKF2``; ``VWN, VWE`` are the air-mass velocity (the way it blows TO).
 - the autopilot's flight state: ``STAT.isFlying`` and ``STAT.Armed`` (ArduPlane 3.5+).
+- an outside air temperature sensor's ``TEMP.Temp`` (°C, lowest ``Instance``; TEMP_LOG = 1)
+  and the throttle ``CTUN.ThO`` (%), where the log has them.
 - parameters: ARSPD_RATIO, the minimum airspeed ARSPD_FBW_MIN (AIRSPEED_MIN from 4.5), and
   ARSPD_ENABLE / ARSPD_TYPE to explain a log without airspeed.
 
@@ -76,6 +78,8 @@ _WANTED = {
     "XKF2": ("C", "VWN", "VWE"),
     "NKF2": ("C", "VWN", "VWE"),
     "EKF2": ("VWN", "VWE"),
+    "CTUN": ("ThO",),
+    "TEMP": ("Instance", "I", "Temp"),
 }
 
 
@@ -164,6 +168,7 @@ def read_dataflash_streams(path):
     _read_static_and_temperature(data, arsp, t0, s)
     _read_gps(data, t0, s)
     _read_flight_state(data, params, t0, s)
+    _read_oat_and_throttle(data, t0, s)
     for wtype in ("XKF2", "NKF2", "EKF2"):
         wind = data.get(wtype)
         if wind is not None and wind["t"].size and "VWN" in wind:
@@ -237,6 +242,21 @@ def _read_gps(data, t0, s):
     s.gps_source += " (Status>=3)"
     s.gps_ok = gps["Status"] >= 3 if "Status" in gps else np.ones(s.gps_t.size, bool)
     s.gps_alt_m = gps.get("Alt")
+
+
+def _read_oat_and_throttle(data, t0, s):
+    """A temperature sensor's ``TEMP.Temp`` (degC; the lowest instance) as the outside air
+    temperature, and ``CTUN.ThO`` (percent) as the throttle, where the log has them."""
+    temp = data.get("TEMP")
+    if temp is not None and temp["t"].size and "Temp" in temp:
+        temp = _instance0(temp, "Instance" if "Instance" in temp else "I")
+        ok = np.isfinite(temp["Temp"])
+        if ok.sum() >= 2:
+            s.oat_t, s.oat_k = temp["t"][ok] - t0, temp["Temp"][ok] + 273.15
+            s.oat_source = "TEMP.Temp (temperature sensor)"
+    ctun = data.get("CTUN")
+    if ctun is not None and ctun["t"].size and "ThO" in ctun:
+        s.throttle_t, s.throttle, s.throttle_source = ctun["t"] - t0, ctun["ThO"], "CTUN.ThO"
 
 
 def _read_flight_state(data, params, t0, s):

@@ -36,16 +36,18 @@ What is cut (an INFO log line names every cut with its sample count and time spa
       or ``vel_ned_valid == 0``, ArduPilot ``Status < 3``) or a gap between fixes;
     - on the ground or too slow to calibrate: GPS ground speed below `min_groundspeed_mps`
       (5 m/s) or q_ci below `min_qci_pa` (20 Pa, ~11 kt; the flight CSV reader's threshold);
-    - non-finite values, and repeated time stamps of the pressure stream.
+    - non-finite values, and repeated time stamps of the pressure stream;
+    - with ``windows="auto"`` and no window given: what is not steady flight, and what no
+      calibration window holds (`pitotcal.io.windows`).
     Fewer than `MIN_SAMPLES` samples or `MIN_DURATION_S` seconds left is a `FlightDataError`.
 
 Density
-    rho = ps / (R T) with the log's static pressure and a temperature. Neither autopilot logs
-    the outside air temperature: the reader takes the airspeed sensor's temperature where it
-    has one, else the barometer's, and warns that it is the sensor's, not OAT: a sensor 15 K
-    warmer than the air gives a density 5 % low, which the pressure-error model absorbs into
-    k1. Pass `oat_k` (a measured outside air temperature, K) to use it instead. A log without
-    static pressure uses the ISA atmosphere at the GPS altitude, with a warning.
+    rho = ps / (R T) with the log's static pressure and a temperature from the best source
+    the log and the caller have (`pitotcal.io.oat`): `oat_k`, `oat_ground_k` with the standard
+    lapse, a logged OAT sensor, else a pressure chip's own temperature with a warning giving
+    its distance from ISA and what it does to ΔV (a sensor 15 K warmer than the air gives a
+    density 5 % low, which the pressure-error model absorbs into k1). A log without static
+    pressure uses the ISA atmosphere at the GPS altitude, with a warning.
 
 The autopilot's own estimates
     Kept out of the `Flight`'s arrays: `FlightLog.autopilot_wind` is the wind-estimate series
@@ -66,15 +68,17 @@ import numpy as np
 from pitotcal.core import checks
 from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.core.flight import Flight
-from pitotcal.core.units import density_kgm3, isa_pressure_pa, isa_temperature_k, wind_polar
+from pitotcal.core.units import density_kgm3, isa_pressure_pa, wind_polar
 
 from .airborne import airspeed_gate, flight_state_cuts
+from .oat import oat_on_times
 from .flight_checks import QCI_MIN_FLYING_PA, check_window, implausible_samples, window_text
 from .flight_csv import PLAN_NOT_FLIGHT, csv_kind
 from .flightlog import AutopilotWind, FlightLog
 from .read_once import log_file, naming
 from .streams import LOG_EXTENSIONS
 from .timebase import apply_cuts, clean, gps_onto, spans
+from .windows import choose_windows, steady_cuts, windows_record, windows_text
 
 __all__ = ["LOG_COLUMNS", "AutopilotWind", "FlightLog", "load_log", "read_log"]
 
@@ -87,6 +91,7 @@ log = logging.getLogger(__name__)
 MIN_SAMPLES = 50
 MIN_DURATION_S = 10.0
 _GPS_RESAMPLE = ("linear", "hold")
+WINDOW_CHOICES = ("auto", "all")
 _SLOW_HOLD_S = 1.0     # static pressure / temperature may be held this long past their ends
 
 
@@ -101,7 +106,7 @@ def read_log(path, start_s=None, end_s=None, **options):
         Window in seconds since the start of the log (either may be None).
     **options
         `gps_resample`, `gps_latency_s`, `min_groundspeed_mps`, `min_qci_pa`, `oat_k`,
-        `min_airspeed_mps`: see `load_log`.
+        `oat_ground_k`, `min_airspeed_mps`, `windows`: see `load_log`.
 
     Returns
     -------
@@ -123,7 +128,7 @@ def read_log(path, start_s=None, end_s=None, **options):
 
 def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_latency_s=0.0,
              min_groundspeed_mps=5.0, min_qci_pa=QCI_MIN_FLYING_PA, oat_k=None,
-             min_airspeed_mps=None):
+             min_airspeed_mps=None, oat_ground_k=None, windows="all"):
     """Read a log as a `FlightLog`: the `Flight` and the autopilot's own estimates.
 
     Parameters
@@ -147,13 +152,22 @@ def load_log(path, start_s=None, end_s=None, *, gps_resample="linear", gps_laten
     min_airspeed_mps : float, optional
         The take-off and landing gate, indicated airspeed, m/s (`pitotcal.io.airborne`);
         default the autopilot's minimum airspeed parameter where the log has it; 0: no gate.
+    oat_ground_k : float, optional
+        The ground temperature at the take-off point, K, carried up the standard lapse
+        (`pitotcal.io.oat`); with `oat_k` the latter wins.
+    windows : {"all", "auto"}
+        "all" (default) keeps every usable sample as one window; "auto", without `start_s`
+        and `end_s`, keeps the steady flight and chooses the calibration windows from the log
+        (`pitotcal.io.windows`; several windows set `Flight.segment`, and `Flight.reading`
+        gets ``windows`` and ``cut_s``), as `pitotcal identify` does. A given window is always
+        used as it is.
 
     Returns
     -------
     FlightLog
     """
     options = _check_options(gps_resample, gps_latency_s, min_groundspeed_mps, min_qci_pa, oat_k,
-                             min_airspeed_mps)
+                             min_airspeed_mps, oat_ground_k, windows)
     start_s, end_s = check_window(start_s, end_s)
     with naming(path), log_file(path, LOG_EXTENSIONS) as file:   # "-" or a FIFO: read once
         streams = _read_streams(Path(file))
@@ -167,25 +181,36 @@ class _Options(NamedTuple):
     min_q: float
     oat_k: float | None
     min_airspeed: float | None
+    oat_ground_k: float | None
+    windows: str
 
 
 def _check_options(gps_resample, gps_latency_s, min_groundspeed_mps, min_qci_pa, oat_k,
-                   min_airspeed_mps):
+                   min_airspeed_mps, oat_ground_k=None, windows="all"):
     """The reader's options, checked (a `PitotcalError` naming the parameter)."""
     if gps_resample not in _GPS_RESAMPLE:
         raise PitotcalError(f"gps_resample {gps_resample!r} is not one of "
                             f"{', '.join(_GPS_RESAMPLE)}", param="gps_resample")
-    if oat_k is not None:
-        try:
-            oat_k = checks.number("oat_k", oat_k, 150.0, 350.0)
-        except PitotcalError as exc:
-            raise PitotcalError(f"{exc} (an outside air temperature in kelvin)",
-                                param="oat_k") from None
+    windows = checks.choice("windows", windows, WINDOW_CHOICES)
+    oat_k, oat_ground_k = (_kelvin(name, value) for name, value
+                           in (("oat_k", oat_k), ("oat_ground_k", oat_ground_k)))
     if min_airspeed_mps is not None:
         min_airspeed_mps = checks.number("min_airspeed_mps", min_airspeed_mps, 0.0)
     return _Options(gps_resample, checks.number("gps_latency_s", gps_latency_s, 0.0),
                     checks.number("min_groundspeed_mps", min_groundspeed_mps, 0.0),
-                    checks.number("min_qci_pa", min_qci_pa, 0.0), oat_k, min_airspeed_mps)
+                    checks.number("min_qci_pa", min_qci_pa, 0.0), oat_k, min_airspeed_mps,
+                    oat_ground_k, windows)
+
+
+def _kelvin(name, value):
+    """A temperature option checked as kelvin (None stays None)."""
+    if value is None:
+        return None
+    try:
+        return checks.number(name, value, 150.0, 350.0)
+    except PitotcalError as exc:
+        raise PitotcalError(f"{exc} (an outside air temperature in kelvin)",
+                            param=name) from None
 
 
 def _read_streams(path):
@@ -222,7 +247,7 @@ def _assemble(s, name, start_s, end_s, opt):
     t, q, n_bad_rows, state = _pressure_in_window(s, name, start_s, end_s, opt.min_airspeed)
     gps = gps_onto(t, s, name, opt.gps_resample, opt.gps_latency_s)
     cuts = {**state, "no valid GPS fix": ~gps.ok}
-    rho, static_ok, temp_source, ps, oat = _density(s, t, gps.alt, opt.oat_k)
+    rho, static_ok, temp_source, ps, oat = _density(s, t, q, gps.alt, opt)
     if static_ok is not None:
         cuts["no static pressure"] = ~static_ok
     slow = {**state,
@@ -235,7 +260,11 @@ def _assemble(s, name, start_s, end_s, opt):
         name, t, qc_pa=q, gps_vn_mps=gps.vn, gps_ve_mps=gps.ve, rho_kgm3=rho,
         gps_vd_mps=gps.vd if s.gps_vd is not None else None)
 
+    auto = opt.windows == "auto" and start_s is None and end_s is None
+    if auto:
+        cuts.update(steady_cuts(t, q, gps, s, airspeed_gate(s, opt.min_airspeed)[0]))
     keep, excluded, attributed = apply_cuts(name, t, cuts)
+    windows = _choose(name, t, keep, gps, excluded, attributed, s) if auto else None
     if n_bad_rows:
         excluded["non-finite or repeated time"] = int(n_bad_rows)
         log.info("%s: dropped %d non-finite or repeated pressure samples", name, n_bad_rows)
@@ -248,16 +277,50 @@ def _assemble(s, name, start_s, end_s, opt):
         f"{reason}: {n} samples ({spans(t, attributed[reason], 3)})" if reason in attributed
         else f"{reason}: {n}" for reason, n in excluded.items()) or "none"
     meta = _meta(s, name, kt, (start_s, end_s), temp_source, opt, excluded_text, wind)
+    if windows is not None:
+        meta["windows"] = windows_text(windows_record(t, windows, attributed)).replace("\n", "; ")
     flight = Flight(time_s=kt, qci_pa=q[keep], gps_vn_mps=gps.vn[keep], gps_ve_mps=gps.ve[keep],
                     rho_kgm3=rho[keep], ps_pa=ps[keep], oat_k=oat[keep],
                     gps_vd_mps=gps.vd[keep] if s.gps_vd is not None else None,
                     alt_m=gps.alt[keep] if s.gps_alt_m is not None else None,
                     source=name, meta=meta, n_dropped=int(t.size - keep.sum() + n_bad_rows),
-                    warnings=warned)
+                    warnings=warned, **_segments(windows, t, keep, attributed))
     log.info("%s: %d samples over %.1f s kept (%s)", name, flight.n, kt[-1] - kt[0], s.autopilot)
     return FlightLog(flight=flight, autopilot=s.autopilot, log_format=s.log_format,
                      autopilot_wind=wind, airspeed_scale=dict(s.airspeed_scale),
                      excluded=excluded, conversions=tuple(s.conversions))
+
+
+def _choose(name, t, keep, gps, excluded, attributed, s):
+    """The calibration windows (`pitotcal.io.windows.choose_windows`): `keep`, `excluded` and
+    `attributed` updated in place with what they leave out; the windows, in time order."""
+    cuts, windows, fallback = choose_windows(t, keep, gps.vn, gps.ve)
+    for reason, mask in cuts.items():
+        new = mask & keep
+        if new.any():
+            excluded[reason], attributed[reason] = int(new.sum()), new
+            log.info("%s: cut %d samples for %s (%s)", name, new.sum(), reason, spans(t, new))
+            keep &= ~new
+    if fallback:
+        s.conversions.append(f"no steady window alone is long enough and turns enough: "
+                             f"{windows[0]['reason'].split(': ', 1)[1]}; all steady flight "
+                             "is fitted as one window")
+    for w in windows:
+        w["mask"] = w["mask"] & keep
+    return windows
+
+
+def _segments(windows, t, keep, attributed):
+    """The Flight's `segment` (several windows) and `reading` (windows, cut_s), or nothing."""
+    if windows is None:
+        return {}
+    reading = windows_record(t, windows, attributed)
+    if len(windows) < 2:
+        return {"reading": reading}
+    segment = np.zeros(t.size, int)
+    for i, w in enumerate(windows):
+        segment[w["mask"]] = i
+    return {"reading": reading, "segment": segment[keep]}
 
 
 def _pressure_in_window(s, name, start_s, end_s, min_airspeed_mps):
@@ -283,11 +346,11 @@ def _inside(t, start_s, end_s):
     return (t >= lo) & (t <= hi)
 
 
-def _density(s, t, alt, oat_k):
+def _density(s, t, q, alt, opt):
     """(rho, static_ok or None, temperature source, ps, T): ps / (R T) on the times `t`.
 
-    ps (the static source's pressure) and T also go into the Flight for the compressible
-    calibration, with the same substitutions as the density.
+    ps (the static source's pressure) and T (`pitotcal.io.oat`) also go into the Flight for
+    the compressible calibration, with the same substitutions as the density.
 
     Records every substitution in `s.conversions` (warned later).
     """
@@ -300,20 +363,7 @@ def _density(s, t, alt, oat_k):
         ps = isa_pressure_pa(alt)
         s.static_source = "ISA at GPS altitude (no static pressure in the log)"
         s.conversions.append("no static pressure in the log: ISA pressure at the GPS altitude")
-    if oat_k is not None:
-        temp = np.full_like(t, float(oat_k))
-        temp_source = f"oat_k={oat_k:g} K given by the user"
-    elif s.temp_k is not None and s.temp_t.size >= 2:
-        tt, tk = clean(np.asarray(s.temp_t, float), np.asarray(s.temp_k, float))
-        temp = np.interp(t, tt, tk)
-        temp_source = f"{s.temp_source}: sensor temperature, not OAT"
-        s.conversions.append(f"no outside air temperature in the log: density uses "
-                             f"{s.temp_source}, a sensor temperature, not OAT "
-                             "(give the outside air temperature, `oat_k`)")
-    else:
-        temp = isa_temperature_k(alt)
-        temp_source = "ISA at GPS altitude (no temperature in the log)"
-        s.conversions.append("no temperature in the log: ISA temperature at the GPS altitude")
+    temp, temp_source = oat_on_times(s, t, q, ps, alt, opt.oat_k, opt.oat_ground_k)
     return density_kgm3(ps, temp), static_ok, temp_source, ps, temp
 
 

@@ -26,7 +26,8 @@ PX4_SCALES = ("ASPD_SCALE_1", "ASPD_SCALE")
 
 
 def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None,
-                               temp_recovery=1.0, rh_pct=None):
+                               temp_recovery=1.0, rh_pct=None, oat_ground_k=None,
+                               windows="all"):
     """(Flight, autopilot, {parameter: current value}) of a log or a converted flight CSV,
     the flight read as `read_flight` reads it (its air data made with `temp_recovery`, `rh_pct`).
 
@@ -44,16 +45,20 @@ def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None,
 
         start_s, end_s = check_window(start_s, end_s)
         temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
-        log = load_log(path, start_s, end_s, oat_k=oat_k)
+        log = load_log(path, start_s, end_s, oat_k=oat_k, oat_ground_k=oat_ground_k,
+                       windows=windows)
         params = dict(log.airspeed_scale)
         suffix = log_suffix(path) or Path(path).suffix.lower()
         autopilot = "PX4" if suffix == ".ulg" else "ArduPilot"
         flight = with_static_air(log.flight, temp_recovery=temp_recovery, rh_pct=rh_pct)
-        return with_reading(flight, {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
-                                     "temp_recovery": temp_recovery, "rh_pct": rh_pct}), \
+        reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
+                   "temp_recovery": temp_recovery, "rh_pct": rh_pct}
+        if oat_ground_k is not None:
+            reading["oat_ground_k"] = oat_ground_k
+        return with_reading(flight, reading), \
             autopilot, params
     flight = read_flight(path, start_s, end_s, oat_k=oat_k, temp_recovery=temp_recovery,
-                         rh_pct=rh_pct)
+                         rh_pct=rh_pct, oat_ground_k=oat_ground_k, windows=windows)
     params = {}
     for key, text in flight.meta.items():
         if key.startswith("autopilot_") and key[10:] in (ARDUPILOT_RATIO, *PX4_SCALES):

@@ -86,6 +86,14 @@ class LogStreams:
     min_airspeed_mps: float | None = None       # the autopilot's minimum airspeed parameter
     min_airspeed_source: str = ""
     airspeed_scale: dict = field(default_factory=dict)
+    # a logged outside-air temperature sensor (not a pressure chip's), K; and the throttle, 0-1
+    # or percent, for the whole-flight windows (`pitotcal.io.windows`)
+    oat_t: np.ndarray | None = None
+    oat_k: np.ndarray | None = None
+    oat_source: str = ""
+    throttle_t: np.ndarray | None = None
+    throttle: np.ndarray | None = None
+    throttle_source: str = ""
     conversions: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
 

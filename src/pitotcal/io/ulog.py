@@ -17,6 +17,8 @@ Topics read (pyulog), with the field names of older (v1.11-v1.12) and newer (v1.
   where ``fix_type >= 3`` and ``vel_ned_valid``; altitude ``alt`` (mm) or ``altitude_msl_m``.
 - flight state: ``vehicle_land_detected.landed`` and ``vehicle_status.arming_state`` (flying =
   not landed and armed), and the minimum airspeed parameter FW_AIRSPD_MIN.
+- the throttle, for the whole-flight windows (`pitotcal.io.windows`), where logged:
+  ``vehicle_thrust_setpoint.xyz[0]`` (v1.14+), else ``actuator_controls_0.control[3]``.
 - for comparison only: ``wind_estimate`` (or ``wind``) ``windspeed_north/east`` (the air-mass
   velocity, the way it blows TO) and ``tas_scale``; the parameter ASPD_SCALE (ASPD_SCALE_1).
 
@@ -68,7 +70,8 @@ def _rate_hz(t):
 
 _TOPICS = ("differential_pressure", "airspeed", "vehicle_air_data", "sensor_baro",
            "vehicle_gps_position", "sensor_gps", "wind_estimate", "wind",
-           "vehicle_land_detected", "vehicle_status")
+           "vehicle_land_detected", "vehicle_status", "vehicle_thrust_setpoint",
+           "actuator_controls_0")
 _PX4_ARMED = 2                  # vehicle_status.arming_state ARMED (v1.11 to v1.15)
 
 
@@ -96,6 +99,7 @@ def read_ulog_streams(path):
     _read_gps(ulog, t0, s)
     _read_flight_state(ulog, t0, s)
     _read_autopilot_estimates(ulog, t0, s)
+    _read_throttle(ulog, t0, s)
     return s
 
 
@@ -221,6 +225,19 @@ def _read_flight_state(ulog, t0, s):
     minimum = ulog.initial_parameters.get("FW_AIRSPD_MIN", 0.0)
     if minimum > 0:
         s.min_airspeed_mps, s.min_airspeed_source = float(minimum), "FW_AIRSPD_MIN"
+
+
+def _read_throttle(ulog, t0, s):
+    """The throttle, 0-1, for the whole-flight windows: the fixed-wing forward thrust set-point
+    (``vehicle_thrust_setpoint.xyz[0]``, v1.14+), else ``actuator_controls_0.control[3]``."""
+    for topic, field in (("vehicle_thrust_setpoint", "xyz[0]"),
+                         ("actuator_controls_0", "control[3]")):
+        _, data = _topic(ulog, [topic])
+        if data is not None and field in data and np.size(data[field]) >= 2:
+            s.throttle_t = _times_s(data, t0)
+            s.throttle = np.asarray(data[field], float)
+            s.throttle_source = f"{topic}.{field}"
+            return
 
 
 def _read_autopilot_estimates(ulog, t0, s):
