@@ -2,7 +2,7 @@
 simulated flights and the same arrays.
 
 Run: ``python benchmarks/bench_airspeedfit.py [--flights 100] [--constant-flights 20] [--quick]
-[--no-fetch] [--no-sitl] [--out DIR]``.
+[--no-fetch] [--no-sitl] [--identify-args "..."] [--out DIR]``.
 
 Flights (seeded, `pitotcal.maneuvers.fly.everyday`): the default calibration plan flown in its
 constant 5 m/s wind (`default_plan_flight`, 240 s at 50 Hz), and the 15-minute everyday
@@ -36,7 +36,7 @@ import argparse
 import json
 import math
 import os
-import statistics
+import shlex
 import subprocess
 import sys
 import tempfile
@@ -94,8 +94,9 @@ def make_flights(kind, seeds, tmp):
     return out
 
 
-def commands(csv, out_json, core):
-    py = [sys.executable, "-m", "pitotcal", "identify", str(csv), "--json", str(out_json)]
+def commands(csv, out_json, core, identify_args=()):
+    py = [sys.executable, "-m", "pitotcal", "identify", str(csv), "--json", str(out_json),
+          *identify_args]
     cmds = {"pitotcal inverse": [*py, "--model", "inverse"],
             "pitotcal constant": [*py, "--model", "constant"]}
     if core is not None:
@@ -165,13 +166,14 @@ def answer(name, stdout, out_json):
 
 
 def score(ans, case):
-    """max |ΔV error| (kt), covered (truth inside the stated 2σ at every grid speed), wind
-    track rms error and mean-wind error (m/s)."""
+    """max |ΔV error| (kt), the signed error at the middle speed, covered (truth inside the
+    stated 2σ at every grid speed), wind track rms error and mean-wind error (m/s)."""
     from pitotcal.studies.engine.common import truth_delta_v_kt, vi_grid_kt
 
     grid = vi_grid_kt(case["qci_pa"])
     dv, dv2 = ans["dv"](grid)
-    err = np.abs(dv - np.asarray(truth_delta_v_kt(case["truth"], grid), dtype=float))
+    signed = dv - np.asarray(truth_delta_v_kt(case["truth"], grid), dtype=float)
+    err = np.abs(signed)
     t, wn, we = ans["wind"]
     if t is None:                       # one wind for the whole flight
         t, wn, we = case["time_s"], np.full(case["time_s"].size, wn[0]), \
@@ -179,18 +181,19 @@ def score(ans, case):
     pn, pe = process_wind(case, t)
     fn, fe = case["flown_mean"]
     return {"dv_err_max_kt": float(err.max()), "covered": bool(np.all(err <= dv2)),
+            "dv_err_mid_kt": float(signed[grid.size // 2]),
             "dv_2sigma_max_kt": float(np.max(dv2)),
             "wind_track_rms_mps": float(np.sqrt(np.mean((wn - pn) ** 2 + (we - pe) ** 2))),
             "wind_mean_err_mps": float(math.hypot(np.mean(wn) - fn, np.mean(we) - fe)),
             "warnings": ans["warnings"]}
 
 
-def bench_flights(flights, core, tmp):
+def bench_flights(flights, core, tmp, identify_args=()):
     """{tool: [row per flight]}: each command run once per flight, timed, scored."""
     rows = {}
     for csv, case in flights:
         out_json = Path(tmp) / f"{csv.stem}.json"
-        for name, cmd in commands(csv, out_json, core).items():
+        for name, cmd in commands(csv, out_json, core, identify_args).items():
             try:
                 wall, rss, stdout = run_child(cmd)
                 row = {**score(answer(name, stdout, out_json), case), "wall_s": wall,
@@ -201,24 +204,31 @@ def bench_flights(flights, core, tmp):
     return rows
 
 
+_COLUMNS = ("dv_err_max_kt", "dv_err_mid_kt", "dv_2sigma_max_kt", "wind_track_rms_mps",
+            "wind_mean_err_mps", "wall_s")
+
+
 def summarize(rows):
-    """Per tool: medians and 90th percentiles over the flights that ran."""
+    """Per tool, over the flights that ran: medians (the 90th percentile of max |ΔV error|),
+    the mean signed error at the middle speed with its standard error, counts."""
     out = {}
     for name, runs in rows.items():
         ok = [r for r in runs if "error" not in r]
-        col = {k: np.array([r[k] for r in ok], dtype=float) for k in
-               ("dv_err_max_kt", "wind_track_rms_mps", "wind_mean_err_mps", "wall_s",
-                "dv_2sigma_max_kt")} if ok else {}
-        out[name] = {"n": len(runs), "n_ok": len(ok)} if not ok else {
-            "n": len(runs), "n_ok": len(ok),
+        out[name] = {"n": len(runs), "n_ok": len(ok)}
+        if not ok:
+            continue
+        col = {k: np.array([r[k] for r in ok], dtype=float) for k in _COLUMNS}
+        mid = col["dv_err_mid_kt"]
+        out[name].update({
             "dv_err_max_kt_median": float(np.median(col["dv_err_max_kt"])),
             "dv_err_max_kt_p90": float(np.percentile(col["dv_err_max_kt"], 90)),
+            "dv_err_mid_kt_mean": float(mid.mean()),
+            "dv_err_mid_kt_se": float(mid.std(ddof=1) / math.sqrt(mid.size)) if mid.size > 1
+            else float("nan"),
             "covered": sum(r["covered"] for r in ok),
-            "dv_2sigma_max_kt_median": float(np.median(col["dv_2sigma_max_kt"])),
-            "wind_track_rms_mps_median": float(np.median(col["wind_track_rms_mps"])),
-            "wind_mean_err_mps_median": float(np.median(col["wind_mean_err_mps"])),
-            "wall_s_median": float(np.median(col["wall_s"])),
-            "with_warnings": sum(r["warnings"] > 0 for r in ok)}
+            "with_warnings": sum(r["warnings"] > 0 for r in ok),
+            **{f"{k}_median": float(np.median(col[k])) for k in _COLUMNS
+               if k not in ("dv_err_max_kt", "dv_err_mid_kt")}})
     return out
 
 
@@ -262,29 +272,32 @@ def _params_ratio(text):
     raise ValueError("no ARSPD_RATIO line in the parameter file")
 
 
-def table(summary, sitl, skipped, where):
+def table(summary, sitl, skipped, where, sitl_why="absent (set PITOTCAL_SHARED_DATA)"):
     """The markdown report: one row per scenario and tool, then the SITL log."""
     lines = [f"Machine: {where}", "",
-             "| flights | tool / mode | max \\|ΔV error\\| kt, median (90th pct) | stated 2σ "
-             "covers truth | wind track rms m/s | mean-wind error m/s | wall s (× pitotcal "
-             "inverse) |", "|---|---|---:|---:|---:|---:|---:|"]
+             "| flights | tool / mode | max \\|ΔV error\\| kt, median (90th pct) | mean ΔV "
+             "error at mid speed kt (± 2 se) | stated 2σ kt, median | 2σ covers truth | "
+             "wind track rms m/s | mean-wind error m/s | flights warned | wall s (× pitotcal "
+             "inverse) |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for kind, per_tool in summary.items():
         base = per_tool.get("pitotcal inverse", {}).get("wall_s_median")
         for name, s in per_tool.items():
             label = f"{SCENARIOS[kind]}, {s['n']}"
             if not s["n_ok"]:
-                lines.append(f"| {label} | {name} | failed | | | | |")
+                lines.append(f"| {label} | {name} | failed | | | | | | | |")
                 continue
             ratio = f" ({s['wall_s_median'] / base:.2f}×)" if base else ""
             lines.append(
                 f"| {label} | {name} | {s['dv_err_max_kt_median']:.3f} "
-                f"({s['dv_err_max_kt_p90']:.3f}) | {s['covered']}/{s['n_ok']} | "
-                f"{s['wind_track_rms_mps_median']:.2f} | {s['wind_mean_err_mps_median']:.2f} | "
+                f"({s['dv_err_max_kt_p90']:.3f}) | {s['dv_err_mid_kt_mean']:+.3f} "
+                f"(± {2 * s['dv_err_mid_kt_se']:.3f}) | {s['dv_2sigma_max_kt_median']:.3f} | "
+                f"{s['covered']}/{s['n_ok']} | {s['wind_track_rms_mps_median']:.2f} | "
+                f"{s['wind_mean_err_mps_median']:.2f} | {s['with_warnings']}/{s['n_ok']} | "
                 f"{s['wall_s_median']:.2f}{ratio} |")
     if skipped:
         lines += ["", f"AirspeedFit skipped: {skipped}"]
     if sitl is None:
-        lines += ["", "ArduPlane SITL log: absent (set PITOTCAL_SHARED_DATA)"]
+        lines += ["", f"ArduPlane SITL log: {sitl_why}"]
         return "\n".join(lines)
     lines += ["", f"ArduPlane SITL log, `--oat-c 15`, true ARSPD_RATIO {SITL_RATIO} "
               f"(AirspeedFit on `pitotcal convert`'s CSV, {sitl['convert_s']:.2f} s to convert):",
@@ -308,6 +321,9 @@ def main(argv=None):
     parser.add_argument("--no-fetch", action="store_true",
                         help="use AirspeedFit only if cached or mirrored: never clone it")
     parser.add_argument("--no-sitl", action="store_true", help="leave out the SITL log")
+    parser.add_argument("--identify-args", default="",
+                        help="more options for both `pitotcal identify` runs, one string "
+                             "(e.g. a wind model's option)")
     parser.add_argument("--out", default="airspeedfit-bench",
                         help="folder for airspeedfit.md and airspeedfit.json")
     args = parser.parse_args(argv)
@@ -321,12 +337,14 @@ def main(argv=None):
         for kind, n in (("constant", n_const), ("everyday-constant", n_const),
                         ("drifting", n_drift)):
             if n > 0:
-                rows[kind] = bench_flights(make_flights(kind, range(n), tmp), core, tmp)
+                rows[kind] = bench_flights(make_flights(kind, range(n), tmp), core, tmp,
+                                           shlex.split(args.identify_args))
                 summary[kind] = summarize(rows[kind])
         sitl = None if args.no_sitl else bench_sitl(core, tmp)
     where = (f"{before}; after: load {os.getloadavg()[0]:.1f}; "
              f"{time.perf_counter() - start:.0f} s in all")
-    text = table(summary, sitl, skipped, where)
+    text = table(summary, sitl, skipped, where,
+                 *(["left out (--no-sitl)"] if args.no_sitl else []))
     print(text)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -32,7 +32,8 @@ for (let i = head + 1; i < lines.length; i++) {
     dp.push(parseFloat(f[iq]))
     t.push(parseFloat(f[it])); vn.push(parseFloat(f[ivn])); ve.push(parseFloat(f[ive]))
     vd.push(ivd >= 0 ? parseFloat(f[ivd]) : 0)
-    u.push(Math.sqrt(Math.max(dp[dp.length - 1], 0)) * Math.sqrt(core.SSL_AIR_DENSITY / parseFloat(f[irho])))
+    const eas2tas = Math.sqrt(core.SSL_AIR_DENSITY / parseFloat(f[irho]))
+    u.push(Math.sqrt(Math.max(dp[dp.length - 1], 0)) * eas2tas)
 }
 let window = null
 if (mode) {
@@ -50,8 +51,10 @@ if (mode === 'constant') {
     }))
     process.exit(0)
 }
-const q = mode === 'drifting' ? (process.argv[5] ? parseFloat(process.argv[5]) : PAGE_Q_WIND) : undefined
-const fit = core.calibrate_combined(t, vn, ve, vd, [u], [seed], q === undefined ? undefined : { q_wind: q })
+let q
+if (mode === 'drifting') q = process.argv[5] ? parseFloat(process.argv[5]) : PAGE_Q_WIND
+const fit = core.calibrate_combined(t, vn, ve, vd, [u], [seed],
+                                    q === undefined ? undefined : { q_wind: q })
 let wn = 0, we = 0
 for (const w of fit.wind_ne) { wn += w[0]; we += w[1] }
 wn /= fit.wind_ne.length; we /= fit.wind_ne.length

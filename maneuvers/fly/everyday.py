@@ -66,18 +66,24 @@ def _pattern(radius_m, leg_m):
             (math.pi * radius_m, 1.0 / radius_m))
 
 
+def _right(chi):
+    """Unit vector (north, east) to the right of track `chi` (rad): toward a right turn's
+    centre."""
+    return np.array([-np.sin(chi), np.cos(chi)])
+
+
 def _on_pattern(s_m, pieces, track0_rad):
     """(north m, east m, track rad) at path lengths `s_m` along the repeated pattern from the
-    origin on track `track0_rad` (north 0, clockwise)."""
+    origin on track `track0_rad` (north 0, clockwise); right turns only."""
     starts, pos, chi = [], np.zeros(2), track0_rad
     for length, curv in pieces:
         starts.append((pos.copy(), chi))
         if curv == 0.0:
             pos = pos + length * np.array([math.cos(chi), math.sin(chi)])
         else:
-            centre = pos + np.array([math.cos(chi + math.pi / 2), math.sin(chi + math.pi / 2)]) / curv
+            centre = pos + _right(chi) / curv
             chi = chi + length * curv
-            pos = centre + np.array([math.cos(chi - math.pi / 2), math.sin(chi - math.pi / 2)]) / curv
+            pos = centre - _right(chi) / curv
     edges = np.cumsum([0.0] + [length for length, _ in pieces])
     s = np.mod(np.asarray(s_m, dtype=float), edges[-1])
     k = np.minimum(np.searchsorted(edges, s, side="right") - 1, len(pieces) - 1)
@@ -85,14 +91,15 @@ def _on_pattern(s_m, pieces, track0_rad):
     for i, (_, curv) in enumerate(pieces):
         m = k == i
         d = s[m] - edges[i]
-        (p0n, p0e), chi0 = starts[i]
+        p0, chi0 = starts[i]
         if curv == 0.0:
-            north[m], east[m], track[m] = p0n + d * math.cos(chi0), p0e + d * math.sin(chi0), chi0
+            north[m], east[m], track[m] = (p0[0] + d * math.cos(chi0),
+                                           p0[1] + d * math.sin(chi0), chi0)
         else:
-            cn, ce = p0n + math.cos(chi0 + math.pi / 2) / curv, p0e + math.sin(chi0 + math.pi / 2) / curv
+            centre = p0 + _right(chi0) / curv
             chi = chi0 + d * curv
-            north[m], east[m], track[m] = (cn + np.cos(chi - math.pi / 2) / curv,
-                                           ce + np.sin(chi - math.pi / 2) / curv, chi)
+            north[m], east[m] = centre[0] + np.sin(chi) / curv, centre[1] - np.cos(chi) / curv
+            track[m] = chi
     return north, east, track
 
 
