@@ -50,3 +50,23 @@ def test_the_answers_are_near_the_truth_and_the_drift_is_seen(run):
     if data["skipped"] is None:
         assert s["AirspeedFit drifting"]["dv_err_max_kt_median"] < 0.6
         assert s["AirspeedFit drifting"]["wind_track_rms_mps_median"] < 1.0
+
+
+@pytest.mark.slow
+def test_the_sitl_log_ratios(shared_file, tmp_path):
+    """The SITL log alone (≈ 15 s): identify's recommended ARSPD_RATIO within 0.5 % of the
+    simulator's 1.9936 and inside its 2σ; AirspeedFit's constant-wind ratio too."""
+    import os
+
+    log = shared_file("ardupilot/arduplane_sitl.log")
+    env = {**os.environ, "PITOTCAL_SHARED_DATA": str(log.parents[1])}
+    done = subprocess.run([sys.executable, str(BENCH), "--flights", "0", "--constant-flights",
+                           "0", "--no-fetch", "--out", str(tmp_path)], capture_output=True,
+                          text=True, timeout=300, env=env)
+    assert done.returncode == 0, done.stderr
+    data = json.loads((tmp_path / "airspeedfit.json").read_text())
+    tools = data["sitl"]["tools"]
+    for name in ("pitotcal inverse", "pitotcal constant"):
+        assert abs(tools[name]["error_percent"]) < 0.5 and tools[name]["covered"], name
+    if data["skipped"] is None:
+        assert abs(tools["AirspeedFit constant"]["error_percent"]) < 0.5
