@@ -14,6 +14,9 @@ reader would, and writes what it printed between the markers::
     python docs/readme_numbers.py --bench     # also the speed race against the peers (~5 min:
                                               # benchmarks/bench_peers_speed.py)
     python docs/readme_numbers.py --bench-from RUN.json   # the same from a saved run's --json
+    python docs/readme_numbers.py --afbench   # also accuracy and time against AirspeedFit
+                                              # (~15 min: benchmarks/bench_airspeedfit.py)
+    python docs/readme_numbers.py --afbench-from DIR      # the same from a saved run's --out
     python docs/readme_numbers.py --only legs-flight,studies-usage
 
 The real-log example reads the ArduPlane SITL log from $PITOTCAL_SHARED_DATA (else the nearest
@@ -357,6 +360,25 @@ def peers_speed(tmp):
             f"{run['machine']}.\n\n" + "\n".join(rows) + "\n" + note)
 
 
+AF_BENCH = ROOT / "benchmarks" / "bench_airspeedfit.py"
+AF_SAVED = {}             # {"path": a saved --out folder of the benchmark}, set by --afbench-from
+
+
+def airspeedfit_bench(tmp):
+    """benchmarks/bench_airspeedfit.py: ΔV error, coverage, wind and time against AirspeedFit
+    on the same simulated flights and the SITL log (its table, as the benchmark wrote it)."""
+    saved = AF_SAVED.get("path")
+    if saved is None:
+        saved, env = tmp, dict(os.environ)
+        data = shared_data()
+        if data is not None:
+            env.setdefault("PITOTCAL_SHARED_DATA", str(data))
+        subprocess.run([sys.executable, str(AF_BENCH), "--out", str(tmp)], check=True,
+                       capture_output=True, env=env)
+    run = json.loads((Path(saved) / "airspeedfit.json").read_text(encoding="utf-8"))
+    return f"\n{run['table']}\n"
+
+
 def tests_time(_):
     s = _wall([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"], ROOT, runs=1)
     return f"about {10 * round(s / 10):.0f} s on {_machine()}"
@@ -379,6 +401,7 @@ GENERATORS = {
     "identify-time": ("timings", identify_time),
     "tests-time": ("tests", tests_time),
     "peers-speed": ("bench", peers_speed),
+    "airspeedfit-bench": ("afbench", airspeedfit_bench),
 }
 
 
@@ -433,13 +456,21 @@ def main(argv=None):
                    help="also the speed race against the peers (benchmarks/bench_peers_speed.py)")
     p.add_argument("--bench-from", default=None, metavar="RUN.json",
                    help="the peers' speed block from a saved `bench_peers_speed.py --json` run")
+    p.add_argument("--afbench", action="store_true",
+                   help="also accuracy and time against AirspeedFit "
+                        "(benchmarks/bench_airspeedfit.py, ~15 min)")
+    p.add_argument("--afbench-from", default=None, metavar="DIR",
+                   help="the AirspeedFit block from a saved `bench_airspeedfit.py --out DIR`")
     p.add_argument("--only", default=None, help="comma-separated block names")
     args = p.parse_args(argv)
     if args.bench_from:
         PEERS_SAVED["path"] = args.bench_from
+    if args.afbench_from:
+        AF_SAVED["path"] = args.afbench_from
     kinds = {"fixed", "data"} | ({"timings"} if args.timings else set()) \
         | ({"tests"} if args.tests else set()) | ({"studies"} if args.studies else set()) \
-        | ({"bench"} if args.bench or args.bench_from else set())
+        | ({"bench"} if args.bench or args.bench_from else set()) \
+        | ({"afbench"} if args.afbench or args.afbench_from else set())
     text = README.read_text(encoding="utf-8")
     present = blocks(text)
     names = [n for n in GENERATORS if n in present and GENERATORS[n][0] in kinds]

@@ -8,7 +8,9 @@ Planning: `profiles` (the q(t) schedules), `ocp` (the lateral-path optimal-contr
 parts and picture).
 Flying: `simulator` (`simulate(plan, SimulationOptions(...))`; `options.engine` picks pitotcal's
 point-mass model or JSBSim's), `autopilot` (guidance, auto-throttle, the stepping loop),
-`autothrottle` (the PI speed loop and its check), `turbulence`, `sensors`, `truth`.
+`autothrottle` (the PI speed loop and its check), `turbulence`, `sensors`, `truth`;
+`everyday` (seeded 15-minute survey/loiter flights with speed changes in a constant or
+drifting wind, and the default plan flown).
 
 The names below load their module on first use, so that `pitotcal plan` does not import the
 simulator and `pitotcal simulate` does not import the planner.
@@ -36,6 +38,9 @@ _EXPORTS = {
     "predict_plan_band_kt": ".plan.design",
     "simulate": ".fly.simulator",
     "simulate_jsbsim": ".fly.simulator",
+    "default_plan_flight": ".fly.everyday",
+    "everyday_flight": ".fly.everyday",
+    "everyday_plan": ".fly.everyday",
     "SimulationOptions": ".fly.options",
     "AirSensors": ".fly.options",
     "Fault": ".fly.faults",
