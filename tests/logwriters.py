@@ -227,3 +227,62 @@ def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
     with open(path, "wb") as f:
         f.write(bytes(out))
     return path
+
+
+# --- MAVLink telemetry log ----------------------------------------------------------------
+
+TLOG_T0_S = 1.7e9            # the ground station's clock (s since 1970) at the first message
+
+
+def write_tlog(path, flight, gps_every=2, *, press_diff=True, gps_raw=True, second=None,
+               params=None, armed=None, autopilot=3):
+    """A MAVLink telemetry log of `flight` as a ground station records it: each message after
+    its 8-byte big-endian arrival time (µs since 1970), encoded by pymavlink.
+
+    SCALED_PRESSURE per sample (`press_diff` False: zero, as a vehicle without an airspeed
+    sensor sends it), GPS_RAW_INT every `gps_every`-th sample (`gps_raw` False: only
+    GLOBAL_POSITION_INT), a HEARTBEAT a second (armed inside `armed` = (t0, t1), always when
+    None), PARAM_VALUE of `params` and a ground station's own heartbeat; `second`: q_ci of a
+    second sensor (SCALED_PRESSURE2), Pa.
+    """
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+    mav = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+    gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+    t = flight.time_s - flight.time_s[0]
+    temp_c = _temperature_k(flight) - 273.15
+    out = bytearray()
+
+    def put(t_s, link, msg):
+        out.extend(struct.pack(">Q", int(round((TLOG_T0_S + t_s) * 1e6))) + msg.pack(link))
+
+    for i, (name, value) in enumerate((params or {}).items()):
+        put(0.0, mav, mav.param_value_encode(name.encode(), float(value), 9, len(params), i))
+    vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(flight.n)
+    alt = flight.alt_m if flight.alt_m is not None else np.full(flight.n, 100.0)
+    rate = 1.0 / max(float(np.median(np.diff(t))), 1e-3)
+    for i in range(flight.n):
+        ms = int(round(t[i] * 1000.0))
+        if i % max(int(round(rate)), 1) == 0:
+            on = armed is None or armed[0] <= flight.time_s[i] <= armed[1]
+            put(t[i], mav, mav.heartbeat_encode(1, autopilot, 128 if on else 0, 0, 4, 3))
+            put(t[i], gcs, gcs.heartbeat_encode(6, 8, 0, 0, 0, 3))
+        dp = flight.qci_pa[i] / 100.0 if press_diff else 0.0
+        put(t[i], mav, mav.scaled_pressure_encode(ms, PS_PA / 100.0, dp,
+                                                  int(round(temp_c[i] * 100)), 0))
+        if second is not None:
+            put(t[i], mav, mav.scaled_pressure2_encode(ms, PS_PA / 100.0, second[i] / 100.0,
+                                                       int(round(temp_c[i] * 100)), 0))
+        if i % gps_every == 0:
+            vn, ve = flight.gps_vn_mps[i], flight.gps_ve_mps[i]
+            if gps_raw:
+                cog = int(round(np.degrees(np.arctan2(ve, vn)) % 360.0 * 100)) % 36000
+                put(t[i], mav, mav.gps_raw_int_encode(
+                    ms * 1000, 3, 0, 0, int(round(alt[i] * 1000)), 100, 100,
+                    int(round(np.hypot(vn, ve) * 100)), cog, 10))
+            put(t[i], mav, mav.global_position_int_encode(
+                ms, 0, 0, int(round(alt[i] * 1000)), 0, int(round(vn * 100)),
+                int(round(ve * 100)), int(round(vd[i] * 100)), 0))
+    with open(path, "wb") as f:
+        f.write(bytes(out))
+    return path

@@ -21,13 +21,13 @@ def add_parser(subparsers):
 
     p = subparsers.add_parser(
         "identify", help="identify the pressure error and the wind from a flight",
-        description="Read a flight CSV (or a .ulg/.bin/.log autopilot log), identify the "
+        description="Read a flight CSV (or a .ulg/.bin/.log/.tlog autopilot log), identify the "
                     "pressure-error model and the wind by the output-error method, print a "
                     "summary in knots and degrees with 2-sigma bounds, and optionally write the "
                     "result as JSON and the calibration figure. The input is never modified.")
     p.add_argument("flight", metavar="FLIGHT", nargs="?",
                    help="flight CSV (columns time_s, qc_pa, gps_vn_mps, gps_ve_mps, and rho_kgm3 "
-                        "or ps_pa + oat_k) or a .ulg/.bin/.log autopilot log")
+                        "or ps_pa + oat_k) or a .ulg/.bin/.log/.tlog autopilot log")
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); default %(default)s")

@@ -1,4 +1,5 @@
-"""Autopilot flight logs as a `Flight`: PX4 ULog (`.ulg`) and ArduPilot DataFlash (`.bin`, `.log`).
+"""Autopilot flight logs as a `Flight`: PX4 ULog (`.ulg`), ArduPilot DataFlash (`.bin`, `.log`)
+and MAVLink telemetry logs (`.tlog`, `pitotcal.io.tlog`).
 
 `read_log(path)` returns the `Flight` that `identify` needs; `load_log(path)` returns it inside a
 `FlightLog` with what the autopilot itself estimated (its wind, its airspeed ratio or scale) for
@@ -96,7 +97,8 @@ def read_log(path, start_s=None, end_s=None, **options):
     Parameters
     ----------
     path : str or Path
-        ``.ulg`` (PX4), ``.bin`` or ``.log`` (ArduPilot DataFlash, binary or text).
+        ``.ulg`` (PX4), ``.bin`` or ``.log`` (ArduPilot DataFlash, binary or text), ``.tlog``
+        (MAVLink telemetry log).
     start_s, end_s : float, optional
         Window in seconds since the start of the log (either may be None).
     **options
@@ -191,10 +193,6 @@ def _check_options(gps_resample, gps_latency_s, min_groundspeed_mps, min_qci_pa,
 def _read_streams(path):
     """The raw `LogStreams` of a log file, by its extension."""
     name, suffix = path.name, path.suffix.lower()
-    if suffix == ".tlog":
-        raise FlightDataError(f"{name}: MAVLink telemetry logs (.tlog) are not supported: their "
-                              "message times are radio arrival times; use the autopilot's "
-                              "DataFlash log (.bin) of the same flight")
     if suffix not in LOG_EXTENSIONS:
         kind = csv_kind(path) if path.is_file() else None
         if kind == "flight":
@@ -211,6 +209,9 @@ def _read_streams(path):
     if suffix == ".ulg":
         from .ulog import read_ulog_streams
         return read_ulog_streams(path)
+    if suffix == ".tlog":
+        from .tlog import read_tlog_streams
+        return read_tlog_streams(path)
     from .dataflash import read_dataflash_streams
     return read_dataflash_streams(path)
 

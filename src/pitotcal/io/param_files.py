@@ -47,7 +47,8 @@ def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None,
         log = load_log(path, start_s, end_s, oat_k=oat_k)
         params = dict(log.airspeed_scale)
         suffix = log_suffix(path) or Path(path).suffix.lower()
-        autopilot = "PX4" if suffix == ".ulg" else "ArduPilot"
+        # a telemetry log says which autopilot sent it (its format names it)
+        autopilot = "PX4" if suffix == ".ulg" or "PX4" in log.log_format else "ArduPilot"
         flight = with_static_air(log.flight, temp_recovery=temp_recovery, rh_pct=rh_pct)
         return with_reading(flight, {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                                      "temp_recovery": temp_recovery, "rh_pct": rh_pct}), \
