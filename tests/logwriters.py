@@ -39,13 +39,15 @@ def _inside(t, span):
 
 def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", ratio=2.0,
                       old=False, gps_invalid=None, airspeed_only=False, flying=None,
-                      min_airspeed=None):
+                      min_airspeed=None, second=None, second_ratio=2.0):
     """(formats, rows) of an ArduPilot log of `flight`: formats {name: (id, fmt, columns)}.
 
     `old`: ms time stamps (``TimeMS``), GPS velocity as VelN/VelE; `airspeed_only`: ARSP has
     Airspeed (EAS = sqrt(ratio * dp)) but no DiffPress, as some firmware logs it. `flying`:
     (t0, t1) of the flight's time_s when STAT (5 Hz) says isFlying and Armed (no STAT when
-    None); `min_airspeed`: the ARSPD_FBW_MIN parameter, m/s.
+    None); `min_airspeed`: the ARSPD_FBW_MIN parameter, m/s. `second`: q_ci of a second
+    airspeed sensor, Pa, logged as ARSP instance I = 1 (the first as I = 0; ARSPD2_RATIO
+    `second_ratio`).
     """
     t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
     time_col, tscale, tfmt = ("TimeMS", 1e-3, "I") if old else ("TimeUS", 1.0, "Q")
@@ -54,13 +56,15 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
         return int(round(t_us[i] * tscale))
 
     arsp_cols = ["Airspeed", "Temp"] if airspeed_only else ["Airspeed", "DiffPress", "Temp"]
+    inst = [] if second is None else ["I"]
     # Old (3.x) GPS messages keep the GPS week time in TimeMS and the boot time in T.
     gps_cols = (["Status", "Week", "VelN", "VelE", "VZ", "Alt", "T"] if old
                 else ["Status", "GMS", "GWk", "Spd", "GCrs", "VZ", "Alt"])
     formats = {
         "PARM": (129, "QNf", "TimeUS,Name,Value"),
         "MSG": (134, tfmt + "Z", f"{time_col},Message"),
-        "ARSP": (165, tfmt + "f" * len(arsp_cols), ",".join([time_col] + arsp_cols)),
+        "ARSP": (165, tfmt + "B" * len(inst) + "f" * len(arsp_cols),
+                 ",".join([time_col] + inst + arsp_cols)),
         "BARO": (139, tfmt + "ff", f"{time_col},Press,Temp"),
         "GPS": (130, ("IBHffffI" if old else "QBIHffff"), ",".join([time_col] + gps_cols)),
         "NKF2": (65, tfmt + "Bff", f"{time_col},C,VWN,VWE"),
@@ -72,12 +76,17 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
             (0, "MSG", [stamp(0), firmware])]
     if min_airspeed is not None:
         rows.append((0, "PARM", [int(t_us[0]) - 1000, "ARSPD_FBW_MIN", float(min_airspeed)]))
+    if second is not None:
+        rows.append((0, "PARM", [int(t_us[0]) - 1000, "ARSPD2_RATIO", second_ratio]))
     in_flight = _inside(flight.time_s, flying)
     temp_c = _temperature_k(flight) - 273.15
     eas = np.sqrt(ratio * flight.qci_pa)
     for i in range(flight.n):
         vals = [eas[i], temp_c[i]] if airspeed_only else [eas[i], flight.qci_pa[i], temp_c[i]]
-        rows.append((t_us[i], "ARSP", [stamp(i)] + vals))
+        rows.append((t_us[i], "ARSP", [stamp(i)] + [0] * len(inst) + vals))
+        if second is not None:
+            rows.append((t_us[i], "ARSP", [stamp(i), 1, np.sqrt(second_ratio * second[i]),
+                                           second[i], temp_c[i]]))
         if i % 5 == 0:
             rows.append((t_us[i], "BARO", [stamp(i), PS_PA, temp_c[i]]))
         if i % 10 == 0:
@@ -153,11 +162,13 @@ def _msg(kind, payload):
 
 
 def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
-               firmware_release=0x010E0000 | 0xFF, flying=None, min_airspeed=None):
+               firmware_release=0x010E0000 | 0xFF, flying=None, min_airspeed=None,
+               second=None):
     """A PX4 ULog of `flight`: newer (v1.13+) or older (v1.11) topic and field names.
 
     `flying`: (t0, t1) of the flight's time_s when vehicle_land_detected says not landed
     (armed from the first sample; no such topics when None); `min_airspeed`: FW_AIRSPD_MIN.
+    `second`: q_ci of a second airspeed sensor, Pa: differential_pressure instance 1.
     """
     t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
     temp_c = _temperature_k(flight) - 273.15
@@ -199,9 +210,12 @@ def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
     for i, name in enumerate(topics):
         ids[name] = i
         out += _msg("A", struct.pack("<BH", 0, i) + name.encode())
+    if second is not None:           # the same topic, multi_id 1
+        ids["differential_pressure#1"] = len(topics)
+        out += _msg("A", struct.pack("<BH", 1, len(topics)) + b"differential_pressure")
 
     def data(name, values):
-        fmt = "<" + "".join(_ULOG_TYPES[t] for t, _ in topics[name])
+        fmt = "<" + "".join(_ULOG_TYPES[t] for t, _ in topics[name.split("#")[0]])
         return _msg("D", struct.pack("<H", ids[name]) + struct.pack(fmt, *values))
 
     idx_gps, status = _gps_rows(flight, gps_every, gps_invalid)
@@ -211,6 +225,8 @@ def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
     for i in range(flight.n):
         t = int(t_us[i])
         out += data("differential_pressure", [t, flight.qci_pa[i], temp_c[i]])
+        if second is not None:
+            out += data("differential_pressure#1", [t, second[i], temp_c[i]])
         if i % 5 == 0:
             baro = "vehicle_air_data" if newer else "sensor_baro"
             ps = PS_PA if newer else PS_PA / 100.0          # v1.11 logged hPa here

@@ -373,6 +373,9 @@ def _meta(s, name, kt, window, temp_source, opt, excluded_text, wind):
     if gate:
         meta["min_airspeed_mps"] = f"{gate:g} ({gate_source}): take-off and landing gate"
     meta["excluded"] = excluded_text
+    if s.other_sensors:      # the others are read by pitotcal.io.sensors
+        meta["airspeed_sensors"] = "; ".join([s.pressure_source]
+                                             + [src for _, _, src in s.other_sensors])
     for key, value in s.airspeed_scale.items():
         meta[f"autopilot_{key}"] = f"{value:.6g}"
     if wind is not None and wind.time_s.size:
