@@ -63,8 +63,8 @@ from .compliance import REGULATIONS
 
 __all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "MISFIT_TOLERANCE_KT",
            "MISFIT_TOLERANCE_MAX_KT", "TOLERANCE", "ParameterRecommendation", "ParameterRefused",
-           "check_misfit_tolerance", "misfit_text", "px4_sensor_note", "recommend",
-           "write_parameter_file"]
+           "SENSOR_PARAMETERS", "check_misfit_tolerance", "misfit_text", "px4_sensor_note",
+           "recommend", "sensor_parameter", "write_parameter_file", "write_parameter_set"]
 
 # A parameter is committed only after turning through three quarters of a circle: wind and
 # scale then separate with margin (identify itself needs only more than half a circle).
@@ -160,7 +160,7 @@ class ParameterRecommendation:
 
 
 def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DATA,
-              misfit_tolerance_kt=None, log_parameters=None, **noise):
+              misfit_tolerance_kt=None, log_parameters=None, fits=None, **noise):
     """The airspeed parameter for `autopilot` from `flight`, or a refusal.
 
     Parameters
@@ -179,6 +179,11 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
     log_parameters : dict, optional
         The log's parameters by name (PX4: ``SENS_EN_SDP3X``, ``CAL_AIR_CMODEL``, ...): a
         warning when PX4 scales a compensated IAS (`px4_sensor_note`).
+    fits : dict, optional
+        {model: IdentificationResult} of this flight already fitted ("constant", and
+        "inverse"/"linear" where identifiable), used instead of fitting again: a sensor's
+        results of the joint fit of several sensors sharing one wind
+        (`estimation.identification.multi_sensor`).
     **noise
         `identify`'s noise keywords, passed on: ``gps_noise_std_mps``, ``gps_error_sigma_mps``,
         ``gps_error_tau_s``.
@@ -206,11 +211,13 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
         raise PitotcalError(f"no parameter recommended: the track turned through only "
                             f"{spread:.0f} deg (need {MIN_TRACK_SPREAD_DEG:.0f} before "
                             f"committing {name}); fly a full circle")
-    const = identify(flight, model="constant", air=air, **noise)
+    const = identify(flight, model="constant", air=air, **noise) if fits is None \
+        else fits["constant"]
     if not const.success:
         raise PitotcalError(f"no parameter recommended: the constant-model fit did not "
                             f"converge ({const.message})")
-    fits, notes = _two_coefficient_fits(flight, noise, air)
+    fits, notes = (_two_coefficient_fits(flight, noise, air) if fits is None else
+                   ({m: fits[m] for m in ("inverse", "linear") if m in fits}, []))
     departures = {m: _departure(const, res) for m, res in fits.items()}
     air = getattr(const, "air_data", None) or "incompressible"
     qref = float(np.median(const.qci_pa))
@@ -403,3 +410,26 @@ def write_parameter_file(rec, path):
 
     writer = write_ardupilot_params if rec.autopilot == "ArduPilot" else write_qgc_params
     return writer(path, rec.name, rec.value, rec.comments())
+
+
+# Each airspeed sensor's parameter, by autopilot: ArduPilot has two sensors (ARSPD_, ARSPD2_),
+# PX4 a scale per sensor (ASPD_SCALE_1..3)
+SENSOR_PARAMETERS = {"ArduPilot": (ARDUPILOT_RATIO, "ARSPD2_RATIO"),
+                     "PX4": ("ASPD_SCALE_1", "ASPD_SCALE_2", "ASPD_SCALE_3")}
+
+
+def sensor_parameter(autopilot, index):
+    """The parameter name of airspeed sensor `index` (0 the first) of `autopilot`, or None
+    when the autopilot has no parameter for that many sensors."""
+    names = SENSOR_PARAMETERS.get(autopilot, ())
+    return names[index] if index < len(names) else None
+
+
+def write_parameter_set(recs, path):
+    """Write several sensors' recommendations (`ParameterRecommendation`, one autopilot) as one
+    parameter file its autopilot loads, each with its comment lines. Returns the path."""
+    from pitotcal.io.param_files import write_ardupilot_param_set, write_qgc_param_set
+
+    writer = (write_ardupilot_param_set if recs[0].autopilot == "ArduPilot"
+              else write_qgc_param_set)
+    return writer(path, [(r.name, r.value, r.comments()) for r in recs])

@@ -263,6 +263,8 @@ def run(args):
     from pitotcal.io import is_log_file
     from pitotcal.io.jsonfile import write_json
 
+    from . import identify_sensors as multi
+
     choice("model", args.model, [*MODELS, "auto"])
     choice("air", args.air, AIR_CHOICES)
     source = Path(args.flight)
@@ -270,15 +272,25 @@ def run(args):
     sensors = _sensor_options(args)
     inputs = None if args.no_budget else _budget_inputs(args, sensors)
     flight, autopilot, current = _read(args, source)
-    result = identify(flight, model=args.model, air=args.air,
-                      gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
-                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
+    # a log with two or more airspeed sensors: one wind, one calibration each
+    others = multi.other_sensor_flights(args, source, flight, sensors[0].get("probe_arm_m", 0.0))
+    if others:
+        results = multi.fit_sensors(args, [flight, *others], inputs)
+        result = results[0]
+    else:
+        result = identify(flight, model=args.model, air=args.air,
+                          gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
+                          probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
     budget = result.budget
 
     # every file is written before anything is printed, so a reader that goes away early
     # (`| head`) never costs a file
-    params, refused = None, None
-    if args.params is not None:
+    params, refused, per_sensor = None, None, None
+    if args.params is not None and others:
+        per_sensor = multi.sensor_params(args, [flight, *others], autopilot, current)
+        refused = next((exc for _, exc in per_sensor if exc is not None), None)
+        params = per_sensor[0][0]
+    elif args.params is not None:
         arm_m = sensors[0].get("probe_arm_m", 0.0)
         if arm_m:           # the recommendation refits: the data corrected as the result was
             from pitotcal.estimation.identification.budget import lever_arm_corrected
@@ -289,7 +301,10 @@ def run(args):
             refused = exc
     if args.json is not None:       # the record, with the path as given (a log's names the file)
         write_json(args.json, {**result.to_dict(), "source": str(source),
-                               **_params_record(args, params, refused)})
+                               **_params_record(args, params, per_sensor and per_sensor[0][1]
+                                                or refused),
+                               **(multi.sensors_record(results, [flight, *others], per_sensor)
+                                  if others else {})})
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
 
@@ -299,6 +314,8 @@ def run(args):
     print(result.summary())
     if budget is not None:
         print("\n" + budget_summary(result, budget))
+    if others:
+        multi.print_sensors(results, [flight, *others])
     if not result.converged:
         warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "
                       "are not a calibration", stacklevel=2)
@@ -306,6 +323,9 @@ def run(args):
         print(f"\nWrote {args.json}")
     if plot_path is not None:
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
+    if per_sensor is not None:
+        multi.print_sensor_params(per_sensor, args.params)
+        return 2 if refused is not None else 0
     if refused is not None:
         raise refused
     if params is not None:
