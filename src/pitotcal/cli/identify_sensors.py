@@ -43,7 +43,6 @@ def sensor_params(args, flights, autopilot, current):
     from pitotcal.core.errors import ObservabilityError, PitotcalError
     from pitotcal.estimation.identification.multi_sensor import identify_sensors
     from pitotcal.estimation.reporting import autopilot_params as ap
-    from pitotcal.io.param_files import PX4_SCALES
 
     fits = {}
     for model in ("constant", "inverse", "linear"):
@@ -55,9 +54,8 @@ def sensor_params(args, flights, autopilot, current):
                 raise
     out = []
     for i, flight in enumerate(flights):
+        # PX4 has one scale per sensor only under the names ASPD_SCALE_1, _2, ...
         name = ap.sensor_parameter(autopilot, i)
-        if i == 0 and autopilot == "PX4":   # the scale name the log has (renamed in PX4)
-            name = next((n for n in PX4_SCALES if n in current), name)
         if name is None:
             out.append((None, PitotcalError(f"no parameter recommended for airspeed sensor "
                                             f"{i + 1}: {autopilot} has none for it")))
