@@ -44,7 +44,7 @@ from .oe import DEFAULT_IPOPT_OPTIONS, objective_function
 from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND_NAMES, theta_scales, to_reported
 
-__all__ = ["identify_sensors", "joint_note"]
+__all__ = ["identify_sensors", "joint_note", "sensors_record", "sensors_summary"]
 
 def identify_sensors(flights, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
                      budget=None, ipopt_options=None):
@@ -243,3 +243,29 @@ def joint_note(i, n_sensors):
     return (f"airspeed sensor {i + 1} of {n_sensors}: fitted jointly with the other sensors, "
             "one shared wind; bounds from the colored residuals of all sensors together")
 
+
+
+def sensors_record(results, flights, per_sensor=None):
+    """``{"sensors": [...]}`` of the result record (docs/interfaces.md §3), {} for one sensor:
+    each sensor's record (`IdentificationResult.to_dict`, the usual keys) with its number and
+    pressure source, and with `per_sensor` ((recommendation or None, refusal or None) per
+    sensor) its ``autopilot_parameter``."""
+    if len(results) < 2:
+        return {}
+    out = []
+    for i, (res, flight) in enumerate(zip(results, flights)):
+        item = {"sensor": i + 1, "qc_source": flight.meta.get("qc_source"), **res.to_dict()}
+        if per_sensor is not None:
+            rec, refused = per_sensor[i]
+            item["autopilot_parameter"] = rec.to_dict() if rec is not None else {
+                "refused": str(refused), "structure_misfit": getattr(refused, "misfit", None)}
+        out.append(item)
+    return {"sensors": out}
+
+
+def sensors_summary(results, flights):
+    """The summaries of the sensors beyond the first, each under a heading naming it ("" for
+    one sensor)."""
+    return "".join(f"\nAirspeed sensor {i} ({flight.meta.get('qc_source')}, {flight.n} "
+                   f"samples; the wind shared with sensor 1):\n{res.summary()}\n"
+                   for i, (res, flight) in enumerate(zip(results[1:], flights[1:]), start=2))

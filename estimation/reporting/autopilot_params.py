@@ -64,7 +64,8 @@ from .compliance import REGULATIONS
 __all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "MISFIT_TOLERANCE_KT",
            "MISFIT_TOLERANCE_MAX_KT", "TOLERANCE", "ParameterRecommendation", "ParameterRefused",
            "SENSOR_PARAMETERS", "check_misfit_tolerance", "misfit_text", "px4_sensor_note",
-           "recommend", "sensor_parameter", "write_parameter_file", "write_parameter_set"]
+           "recommend", "recommend_sensors", "sensor_parameter", "sensor_params_text",
+           "write_parameter_file", "write_parameter_set"]
 
 # A parameter is committed only after turning through three quarters of a circle: wind and
 # scale then separate with margin (identify itself needs only more than half a circle).
@@ -433,3 +434,72 @@ def write_parameter_set(recs, path):
     writer = (write_ardupilot_param_set if recs[0].autopilot == "ArduPilot"
               else write_qgc_param_set)
     return writer(path, [(r.name, r.value, r.comments()) for r in recs])
+
+
+def recommend_sensors(flights, autopilot, current, *, air=DEFAULT_AIR_DATA,
+                      misfit_tolerance_kt=None, gps_noise_std_mps=None, path=None):
+    """Each airspeed sensor's parameter from the joint fits of several sensors sharing one
+    wind (`estimation.identification.multi_sensor`): the constant, inverse and linear models
+    fitted jointly, then `recommend` per sensor on its results.
+
+    Parameters
+    ----------
+    flights : sequence of Flight
+        One per sensor, the first sensor's first (`pitotcal.io.sensors`).
+    autopilot : {"ArduPilot", "PX4"}
+    current : dict
+        The log's parameters by name (current values: ``ARSPD2_RATIO``, ``ASPD_SCALE_2``...).
+    path : str or Path, optional
+        Write the recommended ones there as one parameter file (`write_parameter_set`).
+
+    Returns
+    -------
+    list of (ParameterRecommendation or None, PitotcalError or None)
+        Per sensor: its recommendation (named by `sensor_parameter`), or why none.
+    """
+    from ..identification.multi_sensor import identify_sensors
+
+    fits = {}
+    for model in ("constant", "inverse", "linear"):
+        try:
+            fits[model] = identify_sensors(flights, model=model, air=air,
+                                           gps_noise_std_mps=gps_noise_std_mps)
+        except ObservabilityError:
+            if model == "constant":
+                raise
+    out = []
+    for i, flight in enumerate(flights):
+        # PX4 has one scale per sensor only under the names ASPD_SCALE_1, _2, ...
+        name = sensor_parameter(autopilot, i)
+        if name is None:
+            out.append((None, PitotcalError(f"no parameter recommended for airspeed sensor "
+                                            f"{i + 1}: {autopilot} has none for it")))
+            continue
+        try:
+            out.append((recommend(flight, autopilot, current.get(name), name=name, air=air,
+                                  misfit_tolerance_kt=misfit_tolerance_kt,
+                                  log_parameters=current,
+                                  fits={m: r[i] for m, r in fits.items()},
+                                  gps_noise_std_mps=gps_noise_std_mps), None))
+        except PitotcalError as exc:
+            out.append((None, PitotcalError(f"airspeed sensor {i + 1}: {exc}")))
+    recs = [rec for rec, _ in out if rec is not None]
+    if path is not None and recs:
+        write_parameter_set(recs, path)
+    return out
+
+
+def sensor_params_text(per_sensor, path):
+    """Each sensor's recommended parameter (the refusals, already naming their sensor, are
+    the caller's to raise)."""
+    out = []
+    for i, (rec, _) in enumerate(per_sensor, start=1):
+        if rec is None:
+            continue
+        out.append(f"\nAirspeed sensor {i}: recommended {rec.name} = {rec.value:.4f} ± "
+                   f"{rec.two_sigma:.4f} (2σ)"
+                   + ("" if rec.current is None else f", now {rec.current:.6g}")
+                   + f"; wrote {path}")
+        out.append(f"  {rec.misfit_line()}")
+        out += [f"  note: {note}" for note in rec.notes]
+    return "\n".join(out)

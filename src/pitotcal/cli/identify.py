@@ -256,14 +256,11 @@ def run(args):
     import warnings
 
     from pitotcal.core.checks import choice
-    from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
-    from pitotcal.estimation import identify
+    from pitotcal.estimation.identification.multi_sensor import sensors_record, sensors_summary
     from pitotcal.estimation.reporting.budget_tables import budget_summary
     from pitotcal.io import is_log_file
     from pitotcal.io.jsonfile import write_json
-
-    from . import identify_sensors as multi
 
     choice("model", args.model, [*MODELS, "auto"])
     choice("air", args.air, AIR_CHOICES)
@@ -271,40 +268,17 @@ def run(args):
     plot_path = _checked_outputs(args, source)
     sensors = _sensor_options(args)
     inputs = None if args.no_budget else _budget_inputs(args, sensors)
-    flight, autopilot, current = _read(args, source)
-    # a log with two or more airspeed sensors: one wind, one calibration each
-    others = multi.other_sensor_flights(args, source, flight, sensors[0].get("probe_arm_m", 0.0))
-    if others:
-        results = multi.fit_sensors(args, [flight, *others], inputs)
-        result = results[0]
-    else:
-        result = identify(flight, model=args.model, air=args.air,
-                          gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
-                          probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
-    budget = result.budget
+    flight, autopilot, current, flights, results = _identify_all(args, source, sensors, inputs)
+    result, budget = results[0], results[0].budget
 
     # every file is written before anything is printed, so a reader that goes away early
     # (`| head`) never costs a file
-    params, refused, per_sensor = None, None, None
-    if args.params is not None and others:
-        per_sensor = multi.sensor_params(args, [flight, *others], autopilot, current)
-        refused = next((exc for _, exc in per_sensor if exc is not None), None)
-        params = per_sensor[0][0]
-    elif args.params is not None:
-        arm_m = sensors[0].get("probe_arm_m", 0.0)
-        if arm_m:           # the recommendation refits: the data corrected as the result was
-            from pitotcal.estimation.identification.budget import lever_arm_corrected
-            flight = lever_arm_corrected(flight, result, arm_m)
-        try:
-            params = _write_params(args, flight, autopilot, current)
-        except PitotcalError as exc:        # said after the summary
-            refused = exc
+    params, refused, per_sensor = (None, None, None) if args.params is None else \
+        _recommend(args, flights, result, sensors, autopilot, current)
     if args.json is not None:       # the record, with the path as given (a log's names the file)
         write_json(args.json, {**result.to_dict(), "source": str(source),
-                               **_params_record(args, params, per_sensor and per_sensor[0][1]
-                                                or refused),
-                               **(multi.sensors_record(results, [flight, *others], per_sensor)
-                                  if others else {})})
+                               **_params_record(args, params, refused),
+                               **sensors_record(results, flights, per_sensor)})
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
 
@@ -314,8 +288,7 @@ def run(args):
     print(result.summary())
     if budget is not None:
         print("\n" + budget_summary(result, budget))
-    if others:
-        multi.print_sensors(results, [flight, *others])
+    print(sensors_summary(results, flights), end="")      # a log's other airspeed sensors
     if not result.converged:
         warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "
                       "are not a calibration", stacklevel=2)
@@ -323,14 +296,53 @@ def run(args):
         print(f"\nWrote {args.json}")
     if plot_path is not None:
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
-    if per_sensor is not None:
-        multi.print_sensor_params(per_sensor, args.params)
-        return 2 if refused is not None else 0
+    if per_sensor is not None:      # several sensors: each one's, then any refusal
+        from pitotcal.estimation.reporting.autopilot_params import sensor_params_text
+        print(sensor_params_text(per_sensor, args.params))
     if refused is not None:
         raise refused
-    if params is not None:
+    if params is not None and per_sensor is None:
         _print_params(params, args.params)
     return 0
+
+
+def _identify_all(args, source, sensors, inputs):
+    """(flight, autopilot, current parameters, every sensor's flight, their results): one
+    sensor as `identify`; a log with two or more airspeed sensors fitted jointly, one wind."""
+    from pitotcal.estimation import identify
+    from pitotcal.estimation.identification.multi_sensor import identify_sensors
+    from pitotcal.io.sensors import other_sensor_flights
+
+    flight, autopilot, current = _read(args, source)
+    arm_m = sensors[0].get("probe_arm_m", 0.0)
+    flights = [flight, *other_sensor_flights(source, flight, csv_columns=args.columns, single_only={
+        "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m})]
+    fit = (identify_sensors(flights, model=args.model, air=args.air, budget=inputs,
+                            gps_noise_std_mps=args.gps_noise_mps) if len(flights) > 1 else
+           [identify(flight, model=args.model, air=args.air, budget=inputs, probe_arm_m=arm_m,
+                     gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))])
+    return flight, autopilot, current, flights, fit
+
+
+def _recommend(args, flights, result, sensors, autopilot, current):
+    """(recommendation, refusal, per sensor) with --params: the first sensor's, and with
+    several sensors each one's (`recommend_sensors`, written to one file)."""
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.reporting.autopilot_params import recommend_sensors
+
+    if len(flights) > 1:
+        per = recommend_sensors(flights, autopilot, current, air=args.air, path=args.params,
+                                misfit_tolerance_kt=args.misfit_tolerance_kt,
+                                gps_noise_std_mps=args.gps_noise_mps)
+        return per[0][0], next((exc for _, exc in per if exc is not None), None), per
+    flight, arm_m = flights[0], sensors[0].get("probe_arm_m", 0.0)
+    if arm_m:           # the recommendation refits: the data corrected as the result was
+        from pitotcal.estimation.identification.budget import lever_arm_corrected
+        flight = lever_arm_corrected(flight, result, arm_m)
+    try:
+        return _write_params(args, flight, autopilot, current), None, None
+    except PitotcalError as exc:        # said after the summary
+        return None, exc, None
 
 
 def _checked_outputs(args, source):

@@ -18,13 +18,34 @@ from .flight_checks import QCI_MIN_FLYING_PA, check_window
 from .read_once import is_stream, log_file, naming
 from .streams import LOG_EXTENSIONS
 
-__all__ = ["read_other_sensors", "sensor_count"]
+__all__ = ["other_sensor_flights", "read_other_sensors", "sensor_count"]
 
 
 def sensor_count(flight):
     """How many airspeed sensors the log of `flight` has (1 when its meta names no others)."""
     named = str(flight.meta.get("airspeed_sensors", "") or "")
     return len(named.split("; ")) if named else 1
+
+
+def other_sensor_flights(path, flight, *, csv_columns=None, single_only=None):
+    """`read_other_sensors` of the log `flight` was read from, read as `flight` was (its
+    `Flight.reading`), when its meta names more than one sensor; [] for one sensor or a CSV
+    export (`csv_columns`), and with a warning when options that apply to one sensor's fit
+    only are given (`single_only`: {option name: value}, None or 0 when not given)."""
+    n = sensor_count(flight)
+    if n < 2 or csv_columns is not None:
+        return []
+    given = [name for name, value in (single_only or {}).items() if value]
+    if given:
+        warnings.warn(f"{Path(str(path)).name}: the log has {n} airspeed sensors; "
+                      f"{', '.join(given)} applies to one sensor's fit: the first sensor "
+                      "alone is calibrated", stacklevel=2)
+        return []
+    reading = dict(getattr(flight, "reading", None) or {})
+    return read_other_sensors(path, reading.get("start_s"), reading.get("end_s"),
+                              oat_k=reading.get("oat_k"),
+                              temp_recovery=reading.get("temp_recovery", 1.0),
+                              rh_pct=reading.get("rh_pct"))
 
 
 def read_other_sensors(path, start_s=None, end_s=None, *, oat_k=None, temp_recovery=1.0,
