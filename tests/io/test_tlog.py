@@ -87,3 +87,28 @@ def _cut(src, dst, n_bytes):
 def _garbled(path):
     path.write_bytes(np.random.default_rng(5).integers(0, 256, 500, dtype=np.uint8).tobytes())
     return path
+
+
+def test_second_sensors_are_read_each_on_its_own_and_a_dead_one_is_left_out(tmp_path,
+                                                                           truth_flight):
+    """ARSP instance 1, a PX4 differential_pressure instance 1 and SCALED_PRESSURE2 each become
+    their own flight; a second sensor reading zero is left out with a warning."""
+    from logwriters import write_dataflash_bin, write_ulog
+
+    from pitotcal.io import read_flight
+    from pitotcal.io.sensors import read_other_sensors, sensor_count
+
+    flight, _ = truth_flight
+    second = flight.qci_pa * 1.05
+    for writer, name in ((write_dataflash_bin, "two.bin"), (write_ulog, "two.ulg"),
+                         (write_tlog, "two.tlog")):
+        path = writer(tmp_path / name, flight, second=second)
+        with pytest.warns(UserWarning):
+            first = read_flight(path)
+        (other,) = read_other_sensors(path)
+        assert sensor_count(first) == 2 and other.meta["qc_source"] != first.meta["qc_source"]
+        np.testing.assert_allclose(other.qci_pa, 1.05 * first.qci_pa, rtol=2e-5)
+    dead = write_tlog(tmp_path / "dead.tlog", flight, second=np.full(flight.n, 1e-3))
+    with pytest.warns(UserWarning, match=r"airspeed sensor 2 \(SCALED_PRESSURE2.press_diff "
+                                         r"\(hPa\)\) not calibrated: .*too little usable"):
+        assert read_other_sensors(dead) == []

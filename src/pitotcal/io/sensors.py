@@ -12,6 +12,7 @@ import dataclasses
 import warnings
 from pathlib import Path
 
+from pitotcal.core.errors import FlightDataError
 from pitotcal.core.moist_air import check_air_options, with_static_air
 
 from .flight_checks import QCI_MIN_FLYING_PA, check_window
@@ -65,7 +66,8 @@ def read_other_sensors(path, start_s=None, end_s=None, *, oat_k=None, temp_recov
     list of Flight
         Each with its sensor's pressure source in ``meta["qc_source"]``; the reader's warnings
         about the log (given once, for the first sensor) kept in `Flight.warnings`, not issued
-        again.
+        again. A sensor whose data cannot calibrate (too little usable data: a dead or
+        disconnected sensor) is left out with a warning naming it and why.
     """
     from .logs import _assemble, _check_options, _read_streams
 
@@ -78,13 +80,19 @@ def read_other_sensors(path, start_s=None, end_s=None, *, oat_k=None, temp_recov
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")       # said for the first sensor already
             streams = _read_streams(Path(file))
-            flights = []
-            for t, q, source in streams.other_sensors:
+            flights, unusable = [], []
+            for i, (t, q, source) in enumerate(streams.other_sensors, start=2):
                 one = dataclasses.replace(streams, pressure_t=t, qci_pa=q, pressure_source=source,
                                           other_sensors=[], conversions=list(streams.conversions))
-                flight = _assemble(one, Path(file).name, start_s, end_s, options).flight
-                flight = with_static_air(flight, temp_recovery=temp_recovery, rh_pct=rh_pct)
-                flights.append(flight)
+                try:
+                    flight = _assemble(one, Path(file).name, start_s, end_s, options).flight
+                except FlightDataError as exc:      # a dead second sensor: the first stands
+                    unusable.append(f"airspeed sensor {i} ({source}) not calibrated: {exc}")
+                    continue
+                flights.append(with_static_air(flight, temp_recovery=temp_recovery,
+                                               rh_pct=rh_pct))
+    for text in unusable:
+        warnings.warn(text, stacklevel=2)
     from . import with_reading
 
     reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
