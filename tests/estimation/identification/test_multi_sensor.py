@@ -50,3 +50,39 @@ def test_sensors_on_shifted_time_bases(two):
     for name, true in zip(("k1", "k2"), truth["k_b"]):
         assert abs(rb.value(name) - true) < 2.0 * rb.stddev(name)
     assert np.isfinite(ra.covariance).all()
+
+
+def coverage(n_flights, **flight_kw):
+    """(raw rms z of k1, k2 of both sensors and the wind; 2-sigma coverage of each; rms k1
+    error joint and alone; median sigma(k1) joint / alone) over seeded two-sensor flights."""
+    from pitotcal.estimation.identification.fit import fit
+
+    z, err, ratio = [], [], []
+    for seed in range(n_flights):
+        fa, fb, truth = two_sensor_flights(seed=seed, **flight_kw)
+        ra, rb = identify_sensors([fa, fb], air="incompressible")
+        alone = fit(fa, air="incompressible")
+        wind = [truth["wind_n_mps"], truth["wind_e_mps"]]
+
+        def zs(r, k):
+            return (r.internal_params - np.r_[k, wind]) / np.sqrt(np.diag(r.internal_covariance))
+
+        z.append(np.r_[zs(ra, truth["k_a"]), zs(rb, truth["k_b"])[:2]])
+        err.append([ra.internal_params[0] - truth["k_a"][0],
+                    alone.internal_params[0] - truth["k_a"][0]])
+        ratio.append(np.sqrt(ra.internal_covariance[0, 0] / alone.internal_covariance[0, 0]))
+    z = np.array(z)
+    return (np.sqrt(np.mean(z ** 2, axis=0)), np.mean(np.abs(z) < 2.0, axis=0),
+            np.sqrt(np.mean(np.square(err), axis=0)), float(np.median(ratio)))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("flight_kw", [
+    {"turbulence_mps": 0.5},
+    {"turbulence_mps": 1.0, "gps_rate_hz": 5.0, "gps_noise_mps": 0.1},
+    {"turbulence_mps": 0.0},
+])
+def test_joint_bounds_cover_the_truth(flight_kw):
+    """100 flights of 600 s at 10 Hz (docs/measured.md, two airspeed sensors)."""
+    rms_z, covered, _, _ = coverage(100, n=6000, rate_hz=10.0, **flight_kw)
+    assert np.all(rms_z < 1.15) and np.all(covered >= 0.9), (rms_z, covered)
