@@ -17,12 +17,15 @@ i.e. weighted least squares with each sensor's residual variance sigma_s² (from
 Every sensor is first fitted alone by `fit.fit` (its checks, gates and outlier trimming: the
 joint problem uses the samples that fit kept, and starts from its estimate).
 
-Bounds: the sandwich of the whole problem, M⁻¹ Sᵀ R_vv S M⁻¹, by the colored-residual covariance
-of the single-sensor fit (`uncertainty.covariance.colored_covariance`, its multiscale noise
-model) on all sensors' weighted rows S_s,i / sigma_s and residuals r_s,i / sigma_s merged in
-time order. Turbulence moves every sensor's residual together: in the merged series that is
-the correlation between neighbouring samples (the score contributions of the sensors at one
-time step add before the lags are weighted), while each sensor's own white noise stays white.
+Bounds: the sandwich of the whole problem, M⁻¹ Ω M⁻¹ with M = sum_s S_sᵀ S_s / sigma_s². The
+sensors' weighted residuals and sensitivities are put on the first sensor's time steps (each
+sample onto its nearest step) and rotated into orthonormal channels per step: their sum (the
+turbulence and GPS error all sensors see alike) and contrasts (mostly each sensor's own white
+noise). The score sum_s S_sᵀ r_s is unchanged by the rotation, and Ω is the sum over channels
+of the single-sensor colored-residual middle (`uncertainty.covariance.colored_covariance`,
+multiscale, with the information set to I), each channel's sensitivities first reduced to
+their independent directions (in every channel the k1 columns of all sensors are one column:
+dr/dk1 follows from the shared wind and GPS alone).
 """
 
 import dataclasses
@@ -45,6 +48,7 @@ from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND_NAMES, theta_scales, to_reported
 
 __all__ = ["identify_sensors", "joint_note", "sensors_record", "sensors_summary"]
+
 
 def identify_sensors(flights, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
                      budget=None, ipopt_options=None):
@@ -80,9 +84,9 @@ def identify_sensors(flights, model="inverse", *, air=DEFAULT_AIR_DATA, gps_nois
     singles = [fit(f, model=model, air=air, gps_noise_std_mps=gps_noise_std_mps)
                for f in flights]
     kept = [f.select(np.isin(f.time_s, r.time_s)) for f, r in zip(flights, singles)]
-    parts = [_Part(get_model(r.model), f, flight_channels(f, gps_noise_std_mps,
-                                                         _air_data(f, air)[0]),
-                   _air_data(f, air)[0], r) for f, r in zip(kept, singles)]
+    modes = [_air_data(f, air)[0] for f in kept]
+    parts = [_Part(get_model(r.model), f, flight_channels(f, gps_noise_std_mps, mode), mode, r)
+             for f, r, mode in zip(kept, singles, modes)]
     t0 = time.perf_counter()
     theta, stats = _solve(parts, options)
     cov, colored = _sandwich(parts, theta)
