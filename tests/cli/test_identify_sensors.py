@@ -97,6 +97,10 @@ def test_tlog_with_two_sensors_identifies_and_converts(two, tmp_path, capsys):
     head = csv.read_text()[:3000]
     assert "# qc_source: SCALED_PRESSURE.press_diff (hPa)" in head
     assert "# autopilot_ARSPD_RATIO: 1.9" in head
+    assert "# airspeed_sensors: SCALED_PRESSURE.press_diff (hPa); SCALED_PRESSURE2" in head
+    # the converted CSV holds the first sensor: identified as it alone
+    assert _run(["identify", str(csv), "--no-budget", "--json", str(rec)]) == 0
+    assert "sensors" not in json.loads(rec.read_text())
 
 
 def test_tlog_without_airspeed_exits_2_in_one_line(two, tmp_path, capsys):

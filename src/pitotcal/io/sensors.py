@@ -30,11 +30,15 @@ def sensor_count(flight):
 
 def other_sensor_flights(path, flight, *, csv_columns=None, single_only=None):
     """`read_other_sensors` of the log `flight` was read from, read as `flight` was (its
-    `Flight.reading`), when its meta names more than one sensor; [] for one sensor or a CSV
-    export (`csv_columns`), and with a warning when options that apply to one sensor's fit
-    only are given (`single_only`: {option name: value}, None or 0 when not given)."""
+    `Flight.reading`), when its meta names more than one sensor; [] for one sensor, a stream
+    or a CSV (a `csv_columns` export, or `convert`'s, which holds the first sensor), and with
+    a warning when options that apply to one sensor's fit only are given (`single_only`:
+    {option name: value}, None or 0 when not given)."""
+    from . import is_log_file
+
     n = sensor_count(flight)
-    if n < 2 or csv_columns is not None:
+    # a CSV (`convert`'s keeps the log's airspeed_sensors line) has the first sensor only
+    if n < 2 or csv_columns is not None or not is_log_file(path):
         return []
     given = [name for name, value in (single_only or {}).items() if value]
     if given:
