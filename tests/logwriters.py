@@ -39,7 +39,7 @@ def _inside(t, span):
 
 def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", ratio=2.0,
                       old=False, gps_invalid=None, airspeed_only=False, flying=None,
-                      min_airspeed=None, second=None, second_ratio=2.0):
+                      min_airspeed=None, second=None, second_ratio=2.0, second_as="ARSP"):
     """(formats, rows) of an ArduPilot log of `flight`: formats {name: (id, fmt, columns)}.
 
     `old`: ms time stamps (``TimeMS``), GPS velocity as VelN/VelE; `airspeed_only`: ARSP has
@@ -47,7 +47,7 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
     (t0, t1) of the flight's time_s when STAT (5 Hz) says isFlying and Armed (no STAT when
     None); `min_airspeed`: the ARSPD_FBW_MIN parameter, m/s. `second`: q_ci of a second
     airspeed sensor, Pa, logged as ARSP instance I = 1 (the first as I = 0; ARSPD2_RATIO
-    `second_ratio`).
+    `second_ratio`), or with `second_as` "ASP2" as older firmware logs it (ASP2, no I field).
     """
     t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
     time_col, tscale, tfmt = ("TimeMS", 1e-3, "I") if old else ("TimeUS", 1.0, "Q")
@@ -56,7 +56,7 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
         return int(round(t_us[i] * tscale))
 
     arsp_cols = ["Airspeed", "Temp"] if airspeed_only else ["Airspeed", "DiffPress", "Temp"]
-    inst = [] if second is None else ["I"]
+    inst = [] if second is None or second_as == "ASP2" else ["I"]
     # Old (3.x) GPS messages keep the GPS week time in TimeMS and the boot time in T.
     gps_cols = (["Status", "Week", "VelN", "VelE", "VZ", "Alt", "T"] if old
                 else ["Status", "GMS", "GWk", "Spd", "GCrs", "VZ", "Alt"])
@@ -69,6 +69,8 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
         "GPS": (130, ("IBHffffI" if old else "QBIHffff"), ",".join([time_col] + gps_cols)),
         "NKF2": (65, tfmt + "Bff", f"{time_col},C,VWN,VWE"),
     }
+    if second is not None and second_as == "ASP2":
+        formats["ASP2"] = (166, tfmt + "fff", f"{time_col},Airspeed,DiffPress,Temp")
     if flying is not None:
         formats["STAT"] = (5, tfmt + "BB", f"{time_col},isFlying,Armed")
     rows = [(0, "PARM", [int(t_us[0]) - 1000, "ARSPD_RATIO", ratio]),
@@ -85,8 +87,8 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
         vals = [eas[i], temp_c[i]] if airspeed_only else [eas[i], flight.qci_pa[i], temp_c[i]]
         rows.append((t_us[i], "ARSP", [stamp(i)] + [0] * len(inst) + vals))
         if second is not None:
-            rows.append((t_us[i], "ARSP", [stamp(i), 1, np.sqrt(second_ratio * second[i]),
-                                           second[i], temp_c[i]]))
+            rows.append((t_us[i], second_as, [stamp(i)] + [1] * len(inst) + [
+                np.sqrt(second_ratio * second[i]), second[i], temp_c[i]]))
         if i % 5 == 0:
             rows.append((t_us[i], "BARO", [stamp(i), PS_PA, temp_c[i]]))
         if i % 10 == 0:

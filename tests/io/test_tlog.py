@@ -91,8 +91,9 @@ def _garbled(path):
 
 def test_second_sensors_are_read_each_on_its_own_and_a_dead_one_is_left_out(tmp_path,
                                                                            truth_flight):
-    """ARSP instance 1, a PX4 differential_pressure instance 1 and SCALED_PRESSURE2 each become
-    their own flight; a second sensor reading zero is left out with a warning."""
+    """ARSP instance 1 (an older log's ASP2), a PX4 differential_pressure instance 1 and
+    SCALED_PRESSURE2 each become their own flight; a dead second sensor is left out with a
+    warning."""
     from logwriters import write_dataflash_bin, write_ulog
 
     from pitotcal.io import read_flight
@@ -100,9 +101,10 @@ def test_second_sensors_are_read_each_on_its_own_and_a_dead_one_is_left_out(tmp_
 
     flight, _ = truth_flight
     second = flight.qci_pa * 1.05
-    for writer, name in ((write_dataflash_bin, "two.bin"), (write_ulog, "two.ulg"),
-                         (write_tlog, "two.tlog")):
-        path = writer(tmp_path / name, flight, second=second)
+    cases = ((write_dataflash_bin, "two.bin", {}), (write_ulog, "two.ulg", {}),
+             (write_tlog, "two.tlog", {}), (write_dataflash_bin, "asp2.bin", {"second_as": "ASP2"}))
+    for writer, name, kw in cases:
+        path = writer(tmp_path / name, flight, second=second, **kw)
         with pytest.warns(UserWarning):
             first = read_flight(path)
         (other,) = read_other_sensors(path)
