@@ -163,16 +163,25 @@ def _read_pressure(data, t0, s, name):
     if np.any(sp["press_abs"] > 0):
         s.static_t, s.ps_pa, s.static_source = t, sp["press_abs"] * 100.0, \
             "SCALED_PRESSURE.press_abs (hPa)"
-    if np.any(sp["temperature_press_diff"] != 0):
-        s.temp_t, s.temp_k = t, sp["temperature_press_diff"] / 100.0 + 273.15
+    diff_k, chip_k = _kelvin(sp["temperature_press_diff"]), _kelvin(sp["temperature"])
+    if np.isfinite(diff_k).any():
+        s.temp_t, s.temp_k = t, diff_k
         s.temp_source = "SCALED_PRESSURE.temperature_press_diff (airspeed sensor)"
-    elif np.any(sp["temperature"] != 0):
-        s.temp_t, s.temp_k = t, sp["temperature"] / 100.0 + 273.15
+    elif np.isfinite(chip_k).any():
+        s.temp_t, s.temp_k = t, chip_k
         s.temp_source = "SCALED_PRESSURE.temperature (baro chip)"
     sp2 = data["SCALED_PRESSURE2"]
     if sp2["t"].size and np.any(sp2["press_diff"] != 0):
         s.other_sensors.append((sp2["t"] - t0, sp2["press_diff"] * 100.0,
                                 "SCALED_PRESSURE2.press_diff (hPa)"))
+
+
+def _kelvin(cdeg_c):
+    """A cdegC temperature field in K; NaN where it says "not available" (0 or 1 cdegC in
+    current MAVLink, -1 / INT16_MAX in older senders) or lies outside -80..+80 degC."""
+    c = np.asarray(cdeg_c, float)
+    ok = (np.abs(c) > 1.0) & (np.abs(c) <= 8000.0)
+    return np.where(ok, c / 100.0 + 273.15, np.nan)
 
 
 def _read_gps(data, t0, s, name):
