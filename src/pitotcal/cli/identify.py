@@ -22,7 +22,8 @@ def add_parser(subparsers):
     p = subparsers.add_parser(
         "identify", help="identify the pressure error and the wind from a flight",
         description="Read a flight CSV (or a .ulg/.bin/.log/.tlog autopilot log), identify the "
-                    "pressure-error model and the wind by the output-error method, print a "
+                    "pressure-error model and the wind by the output-error method (a log's two or "
+                    "more airspeed sensors jointly: one wind, one calibration each), print a "
                     "summary in knots and degrees with 2-sigma bounds, and optionally write the "
                     "result as JSON and the calibration figure. The input is never modified.")
     p.add_argument("flight", metavar="FLIGHT", nargs="?",
@@ -309,8 +310,7 @@ def run(args):
 def _identify_all(args, source, sensors, inputs):
     """(flight, autopilot, current parameters, every sensor's flight, their results): one
     sensor as `identify`; a log with two or more airspeed sensors fitted jointly, one wind."""
-    from pitotcal.estimation import identify
-    from pitotcal.estimation.identification.multi_sensor import identify_sensors
+    from pitotcal.estimation import identify, identify_sensors
     from pitotcal.io.sensors import other_sensor_flights
 
     flight, autopilot, current = _read(args, source)
