@@ -39,7 +39,8 @@ def _inside(t, span):
 
 def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", ratio=2.0,
                       old=False, gps_invalid=None, airspeed_only=False, flying=None,
-                      min_airspeed=None, oat_sensor_c=None, throttle_pct=None):
+                      min_airspeed=None, oat_sensor_c=None, throttle_pct=None,
+                      second=None, second_ratio=2.0, second_as="ARSP"):
     """(formats, rows) of an ArduPilot log of `flight`: formats {name: (id, fmt, columns)}.
 
     `old`: ms time stamps (``TimeMS``), GPS velocity as VelN/VelE; `airspeed_only`: ARSP has
@@ -47,6 +48,9 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
     (t0, t1) of the flight's time_s when STAT (5 Hz) says isFlying and Armed (no STAT when
     None); `min_airspeed`: the ARSPD_FBW_MIN parameter, m/s. `oat_sensor_c`: a temperature
     sensor's TEMP messages (1 Hz, degC); `throttle_pct`: CTUN.ThO per sample (5 Hz), %.
+    `second`: q_ci of a second airspeed sensor, Pa, logged as ARSP instance I = 1 (the first as
+    I = 0; ARSPD2_RATIO `second_ratio`), or with `second_as` "ASP2" as older firmware logs it
+    (ASP2, no I field).
     """
     t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
     time_col, tscale, tfmt = ("TimeMS", 1e-3, "I") if old else ("TimeUS", 1.0, "Q")
@@ -55,17 +59,21 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
         return int(round(t_us[i] * tscale))
 
     arsp_cols = ["Airspeed", "Temp"] if airspeed_only else ["Airspeed", "DiffPress", "Temp"]
+    inst = [] if second is None or second_as == "ASP2" else ["I"]
     # Old (3.x) GPS messages keep the GPS week time in TimeMS and the boot time in T.
     gps_cols = (["Status", "Week", "VelN", "VelE", "VZ", "Alt", "T"] if old
                 else ["Status", "GMS", "GWk", "Spd", "GCrs", "VZ", "Alt"])
     formats = {
         "PARM": (129, "QNf", "TimeUS,Name,Value"),
         "MSG": (134, tfmt + "Z", f"{time_col},Message"),
-        "ARSP": (165, tfmt + "f" * len(arsp_cols), ",".join([time_col] + arsp_cols)),
+        "ARSP": (165, tfmt + "B" * len(inst) + "f" * len(arsp_cols),
+                 ",".join([time_col] + inst + arsp_cols)),
         "BARO": (139, tfmt + "ff", f"{time_col},Press,Temp"),
         "GPS": (130, ("IBHffffI" if old else "QBIHffff"), ",".join([time_col] + gps_cols)),
         "NKF2": (65, tfmt + "Bff", f"{time_col},C,VWN,VWE"),
     }
+    if second is not None and second_as == "ASP2":
+        formats["ASP2"] = (166, tfmt + "fff", f"{time_col},Airspeed,DiffPress,Temp")
     if flying is not None:
         formats["STAT"] = (5, tfmt + "BB", f"{time_col},isFlying,Armed")
     if oat_sensor_c is not None:
@@ -77,12 +85,17 @@ def dataflash_records(flight, gps_every=2, firmware="ArduPlane V4.1.0 (test)", r
             (0, "MSG", [stamp(0), firmware])]
     if min_airspeed is not None:
         rows.append((0, "PARM", [int(t_us[0]) - 1000, "ARSPD_FBW_MIN", float(min_airspeed)]))
+    if second is not None:
+        rows.append((0, "PARM", [int(t_us[0]) - 1000, "ARSPD2_RATIO", second_ratio]))
     in_flight = _inside(flight.time_s, flying)
     temp_c = _temperature_k(flight) - 273.15
     eas = np.sqrt(ratio * flight.qci_pa)
     for i in range(flight.n):
         vals = [eas[i], temp_c[i]] if airspeed_only else [eas[i], flight.qci_pa[i], temp_c[i]]
-        rows.append((t_us[i], "ARSP", [stamp(i)] + vals))
+        rows.append((t_us[i], "ARSP", [stamp(i)] + [0] * len(inst) + vals))
+        if second is not None:
+            rows.append((t_us[i], second_as, [stamp(i)] + [1] * len(inst) + [
+                np.sqrt(second_ratio * second[i]), second[i], temp_c[i]]))
         if i % 5 == 0:
             rows.append((t_us[i], "BARO", [stamp(i), PS_PA, temp_c[i]]))
         if i % 10 == 0:
@@ -162,11 +175,13 @@ def _msg(kind, payload):
 
 
 def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
-               firmware_release=0x010E0000 | 0xFF, flying=None, min_airspeed=None):
+               firmware_release=0x010E0000 | 0xFF, flying=None, min_airspeed=None,
+               second=None):
     """A PX4 ULog of `flight`: newer (v1.13+) or older (v1.11) topic and field names.
 
     `flying`: (t0, t1) of the flight's time_s when vehicle_land_detected says not landed
     (armed from the first sample; no such topics when None); `min_airspeed`: FW_AIRSPD_MIN.
+    `second`: q_ci of a second airspeed sensor, Pa: differential_pressure instance 1.
     """
     t_us = np.round((flight.time_s - flight.time_s[0] + BOOT_S) * 1e6).astype(np.int64)
     temp_c = _temperature_k(flight) - 273.15
@@ -208,9 +223,12 @@ def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
     for i, name in enumerate(topics):
         ids[name] = i
         out += _msg("A", struct.pack("<BH", 0, i) + name.encode())
+    if second is not None:           # the same topic, multi_id 1
+        ids["differential_pressure#1"] = len(topics)
+        out += _msg("A", struct.pack("<BH", 1, len(topics)) + b"differential_pressure")
 
     def data(name, values):
-        fmt = "<" + "".join(_ULOG_TYPES[t] for t, _ in topics[name])
+        fmt = "<" + "".join(_ULOG_TYPES[t] for t, _ in topics[name.split("#")[0]])
         return _msg("D", struct.pack("<H", ids[name]) + struct.pack(fmt, *values))
 
     idx_gps, status = _gps_rows(flight, gps_every, gps_invalid)
@@ -220,6 +238,8 @@ def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
     for i in range(flight.n):
         t = int(t_us[i])
         out += data("differential_pressure", [t, flight.qci_pa[i], temp_c[i]])
+        if second is not None:
+            out += data("differential_pressure#1", [t, second[i], temp_c[i]])
         if i % 5 == 0:
             baro = "vehicle_air_data" if newer else "sensor_baro"
             ps = PS_PA if newer else PS_PA / 100.0          # v1.11 logged hPa here
@@ -233,6 +253,65 @@ def write_ulog(path, flight, gps_every=2, newer=True, gps_invalid=None,
         if flying is not None and i % 10 == 0:
             out += data("vehicle_land_detected", [t, int(not in_flight[i])])
             out += data("vehicle_status", [t, 2])
+    with open(path, "wb") as f:
+        f.write(bytes(out))
+    return path
+
+
+# --- MAVLink telemetry log ----------------------------------------------------------------
+
+TLOG_T0_S = 1.7e9            # the ground station's clock (s since 1970) at the first message
+
+
+def write_tlog(path, flight, gps_every=2, *, press_diff=True, gps_raw=True, second=None,
+               params=None, armed=None, autopilot=3):
+    """A MAVLink telemetry log of `flight` as a ground station records it: each message after
+    its 8-byte big-endian arrival time (µs since 1970), encoded by pymavlink.
+
+    SCALED_PRESSURE per sample (`press_diff` False: zero, as a vehicle without an airspeed
+    sensor sends it), GPS_RAW_INT every `gps_every`-th sample (`gps_raw` False: only
+    GLOBAL_POSITION_INT), a HEARTBEAT a second (armed inside `armed` = (t0, t1), always when
+    None), PARAM_VALUE of `params` and a ground station's own heartbeat; `second`: q_ci of a
+    second sensor (SCALED_PRESSURE2), Pa.
+    """
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+    mav = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+    gcs = mavlink.MAVLink(None, srcSystem=255, srcComponent=190)
+    t = flight.time_s - flight.time_s[0]
+    temp_c = _temperature_k(flight) - 273.15
+    out = bytearray()
+
+    def put(t_s, link, msg):
+        out.extend(struct.pack(">Q", int(round((TLOG_T0_S + t_s) * 1e6))) + msg.pack(link))
+
+    for i, (name, value) in enumerate((params or {}).items()):
+        put(0.0, mav, mav.param_value_encode(name.encode(), float(value), 9, len(params), i))
+    vd = flight.gps_vd_mps if flight.gps_vd_mps is not None else np.zeros(flight.n)
+    alt = flight.alt_m if flight.alt_m is not None else np.full(flight.n, 100.0)
+    rate = 1.0 / max(float(np.median(np.diff(t))), 1e-3)
+    for i in range(flight.n):
+        ms = int(round(t[i] * 1000.0))
+        if i % max(int(round(rate)), 1) == 0:
+            on = armed is None or armed[0] <= flight.time_s[i] <= armed[1]
+            put(t[i], mav, mav.heartbeat_encode(1, autopilot, 128 if on else 0, 0, 4, 3))
+            put(t[i], gcs, gcs.heartbeat_encode(6, 8, 0, 0, 0, 3))
+        dp = flight.qci_pa[i] / 100.0 if press_diff else 0.0
+        put(t[i], mav, mav.scaled_pressure_encode(ms, PS_PA / 100.0, dp,
+                                                  int(round(temp_c[i] * 100)), 0))
+        if second is not None:
+            put(t[i], mav, mav.scaled_pressure2_encode(ms, PS_PA / 100.0, second[i] / 100.0,
+                                                       int(round(temp_c[i] * 100)), 0))
+        if i % gps_every == 0:
+            vn, ve = flight.gps_vn_mps[i], flight.gps_ve_mps[i]
+            if gps_raw:
+                cog = int(round(np.degrees(np.arctan2(ve, vn)) % 360.0 * 100)) % 36000
+                put(t[i], mav, mav.gps_raw_int_encode(
+                    ms * 1000, 3, 0, 0, int(round(alt[i] * 1000)), 100, 100,
+                    int(round(np.hypot(vn, ve) * 100)), cog, 10))
+            put(t[i], mav, mav.global_position_int_encode(
+                ms, 0, 0, int(round(alt[i] * 1000)), 0, int(round(vn * 100)),
+                int(round(ve * 100)), int(round(vd[i] * 100)), 0))
     with open(path, "wb") as f:
         f.write(bytes(out))
     return path

@@ -6,6 +6,8 @@ uniformly from q_lo to q_hi; the air mass moves with the mean wind plus first-or
 Gauss-Markov (Dryden-like) turbulence; GPS may be slower (sample-and-hold) and noisy.
 """
 
+import dataclasses
+
 import numpy as np
 
 from pitotcal.core.flight import Flight
@@ -146,3 +148,21 @@ def reference_static_flight():
     flight, _ = simulate(plan, seed=2, turbulence_mps=0.0, rate_hz=10.0,
                          air_data="compressible")
     return dataclasses.replace(flight, ps_ref_pa=flight.ps_pa - 40.0)
+
+
+def two_sensor_flights(seed=0, k_a=(0.02, -15.0), k_b=(-0.03, 10.0), model="inverse",
+                       qc_noise_pa=0.3, **kw):
+    """Two airspeed sensors on one simulated flight (`synthetic_flight`'s, keywords passed on):
+    the same true q_c, GPS and wind, each sensor its own pressure error and independent noise.
+
+    Returns (flight_a, flight_b, truth): truth as `synthetic_flight`'s, with "k_a" and "k_b".
+    """
+    clean, truth = synthetic_flight(seed=seed, model="constant", k=(0.0,), qc_noise_pa=0.0, **kw)
+    rng = np.random.default_rng(seed + 7919)
+    m = get_model(model)
+    flights = []
+    for name, k in (("a", k_a), ("b", k_b)):
+        qci = qci_from_qc_pa(m, k, clean.qci_pa) + rng.standard_normal(clean.n) * qc_noise_pa
+        flights.append(dataclasses.replace(clean, qci_pa=qci,
+                                           source=f"synthetic(seed={seed}, sensor {name})"))
+    return flights[0], flights[1], {**truth, "k_a": tuple(k_a), "k_b": tuple(k_b)}

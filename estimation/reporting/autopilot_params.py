@@ -63,8 +63,9 @@ from .compliance import REGULATIONS
 
 __all__ = ["MIN_TRACK_SPREAD_DEG", "MISFIT_STEP_KT", "MISFIT_TOLERANCE_KT",
            "MISFIT_TOLERANCE_MAX_KT", "TOLERANCE", "ParameterRecommendation", "ParameterRefused",
-           "check_misfit_tolerance", "misfit_text", "px4_sensor_note", "recommend",
-           "write_parameter_file"]
+           "SENSOR_PARAMETERS", "check_misfit_tolerance", "misfit_text", "px4_sensor_note",
+           "recommend", "recommend_sensors", "sensor_parameter", "sensor_params_text",
+           "write_parameter_file", "write_parameter_set"]
 
 # A parameter is committed only after turning through three quarters of a circle: wind and
 # scale then separate with margin (identify itself needs only more than half a circle).
@@ -160,7 +161,7 @@ class ParameterRecommendation:
 
 
 def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DATA,
-              misfit_tolerance_kt=None, log_parameters=None, **noise):
+              misfit_tolerance_kt=None, log_parameters=None, fits=None, **noise):
     """The airspeed parameter for `autopilot` from `flight`, or a refusal.
 
     Parameters
@@ -179,6 +180,11 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
     log_parameters : dict, optional
         The log's parameters by name (PX4: ``SENS_EN_SDP3X``, ``CAL_AIR_CMODEL``, ...): a
         warning when PX4 scales a compensated IAS (`px4_sensor_note`).
+    fits : dict, optional
+        {model: IdentificationResult} of this flight already fitted ("constant", and
+        "inverse"/"linear" where identifiable), used instead of fitting again: a sensor's
+        results of the joint fit of several sensors sharing one wind
+        (`estimation.identification.multi_sensor`).
     **noise
         `identify`'s noise keywords, passed on: ``gps_noise_std_mps``, ``gps_error_sigma_mps``,
         ``gps_error_tau_s``.
@@ -206,11 +212,13 @@ def recommend(flight, autopilot, current=None, *, name=None, air=DEFAULT_AIR_DAT
         raise PitotcalError(f"no parameter recommended: the track turned through only "
                             f"{spread:.0f} deg (need {MIN_TRACK_SPREAD_DEG:.0f} before "
                             f"committing {name}); fly a full circle")
-    const = identify(flight, model="constant", air=air, **noise)
+    const = identify(flight, model="constant", air=air, **noise) if fits is None \
+        else fits["constant"]
     if not const.success:
         raise PitotcalError(f"no parameter recommended: the constant-model fit did not "
                             f"converge ({const.message})")
-    fits, notes = _two_coefficient_fits(flight, noise, air)
+    fits, notes = (_two_coefficient_fits(flight, noise, air) if fits is None else
+                   ({m: fits[m] for m in ("inverse", "linear") if m in fits}, []))
     departures = {m: _departure(const, res) for m, res in fits.items()}
     air = getattr(const, "air_data", None) or "incompressible"
     qref = float(np.median(const.qci_pa))
@@ -403,3 +411,95 @@ def write_parameter_file(rec, path):
 
     writer = write_ardupilot_params if rec.autopilot == "ArduPilot" else write_qgc_params
     return writer(path, rec.name, rec.value, rec.comments())
+
+
+# Each airspeed sensor's parameter, by autopilot: ArduPilot has two sensors (ARSPD_, ARSPD2_),
+# PX4 a scale per sensor (ASPD_SCALE_1..3)
+SENSOR_PARAMETERS = {"ArduPilot": (ARDUPILOT_RATIO, "ARSPD2_RATIO"),
+                     "PX4": ("ASPD_SCALE_1", "ASPD_SCALE_2", "ASPD_SCALE_3")}
+
+
+def sensor_parameter(autopilot, index):
+    """The parameter name of airspeed sensor `index` (0 the first) of `autopilot`, or None
+    when the autopilot has no parameter for that many sensors."""
+    names = SENSOR_PARAMETERS.get(autopilot, ())
+    return names[index] if index < len(names) else None
+
+
+def write_parameter_set(recs, path):
+    """Write several sensors' recommendations (`ParameterRecommendation`, one autopilot) as one
+    parameter file its autopilot loads, each with its comment lines. Returns the path."""
+    from pitotcal.io.param_files import write_ardupilot_param_set, write_qgc_param_set
+
+    writer = (write_ardupilot_param_set if recs[0].autopilot == "ArduPilot"
+              else write_qgc_param_set)
+    return writer(path, [(r.name, r.value, r.comments()) for r in recs])
+
+
+def recommend_sensors(flights, autopilot, current, *, air=DEFAULT_AIR_DATA,
+                      misfit_tolerance_kt=None, gps_noise_std_mps=None, path=None):
+    """Each airspeed sensor's parameter from the joint fits of several sensors sharing one
+    wind (`estimation.identification.multi_sensor`): the constant, inverse and linear models
+    fitted jointly, then `recommend` per sensor on its results.
+
+    Parameters
+    ----------
+    flights : sequence of Flight
+        One per sensor, the first sensor's first (`pitotcal.io.sensors`).
+    autopilot : {"ArduPilot", "PX4"}
+    current : dict
+        The log's parameters by name (current values: ``ARSPD2_RATIO``, ``ASPD_SCALE_2``...).
+    path : str or Path, optional
+        Write the recommended ones there as one parameter file (`write_parameter_set`).
+
+    Returns
+    -------
+    list of (ParameterRecommendation or None, PitotcalError or None)
+        Per sensor: its recommendation (named by `sensor_parameter`), or why none.
+    """
+    from ..identification.multi_sensor import identify_sensors
+
+    fits = {}
+    for model in ("constant", "inverse", "linear"):
+        try:
+            fits[model] = identify_sensors(flights, model=model, air=air,
+                                           gps_noise_std_mps=gps_noise_std_mps)
+        except ObservabilityError:
+            if model == "constant":
+                raise
+    out = []
+    for i, flight in enumerate(flights):
+        # PX4 has one scale per sensor only under the names ASPD_SCALE_1, _2, ...
+        name = sensor_parameter(autopilot, i)
+        if name is None:
+            out.append((None, PitotcalError(f"no parameter recommended for airspeed sensor "
+                                            f"{i + 1}: {autopilot} has none for it")))
+            continue
+        try:
+            out.append((recommend(flight, autopilot, current.get(name), name=name, air=air,
+                                  misfit_tolerance_kt=misfit_tolerance_kt,
+                                  log_parameters=current,
+                                  fits={m: r[i] for m, r in fits.items()},
+                                  gps_noise_std_mps=gps_noise_std_mps), None))
+        except PitotcalError as exc:
+            out.append((None, PitotcalError(f"airspeed sensor {i + 1}: {exc}")))
+    recs = [rec for rec, _ in out if rec is not None]
+    if path is not None and recs:
+        write_parameter_set(recs, path)
+    return out
+
+
+def sensor_params_text(per_sensor, path):
+    """Each sensor's recommended parameter (the refusals, already naming their sensor, are
+    the caller's to raise)."""
+    out = []
+    for i, (rec, _) in enumerate(per_sensor, start=1):
+        if rec is None:
+            continue
+        out.append(f"\nAirspeed sensor {i}: recommended {rec.name} = {rec.value:.4f} ± "
+                   f"{rec.two_sigma:.4f} (2σ)"
+                   + ("" if rec.current is None else f", now {rec.current:.6g}")
+                   + f"; wrote {path}")
+        out.append(f"  {rec.misfit_line()}")
+        out += [f"  note: {note}" for note in rec.notes]
+    return "\n".join(out)

@@ -306,7 +306,7 @@ def _legs(root):
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     """{name: path} of every input of the suite, and their checksums before it."""
-    from logwriters import write_dataflash_bin, write_ulog
+    from logwriters import write_dataflash_bin, write_tlog, write_ulog
 
     from pitotcal.io import read_flight
 
@@ -322,6 +322,10 @@ def files(tmp_path_factory):
         flight = read_flight(out["flight"])
     out["log_bin"] = write_dataflash_bin(root / "flight.bin", flight) or root / "flight.bin"
     out["log_ulg"] = write_ulog(root / "flight.ulg", flight) or root / "flight.ulg"
+    # telemetry logs: one without airspeed, one cut to its first messages
+    write_tlog(root / "nodp.tlog", flight, press_diff=False)
+    tlog = write_tlog(root / "whole.tlog", flight).read_bytes()
+    (root / "trunc.tlog").write_bytes(tlog[:3000])
     _cells(root, out["flight"])
     _units(root, out["flight"])
     _missing(root, out["flight"])
@@ -405,7 +409,8 @@ def _flight_cases():
 def _log_cases():
     names = [f"{what}.{kind}" for kind in ("bin", "ulg")
              for what in ("trunc1", "trunc50", "random", "empty", "csv_as", "zeroed_head")]
-    names += ["text.log", "empty.log", "ulg_as.bin", "bin_as.ulg", "flight.tlog"]
+    names += ["text.log", "empty.log", "ulg_as.bin", "bin_as.ulg", "flight.tlog", "nodp.tlog",
+              "trunc.tlog"]
     # a log whose first bytes are zeroed is read from the next intact message on
     return [Case(f"{command} log {name}", _with(template, f"{{root}}/{name}"),
                  codes=(0, 2) if name.startswith("zeroed_head") else (2,))

@@ -157,7 +157,7 @@ def test_identify_refuses_oat_c_for_a_csv_and_kelvin(tmp_path, flight, capsys):
 
     path = write_flight_csv(flight, tmp_path / "f.csv")
     assert main(["identify", str(path), "--oat-c", "15"]) == 2
-    assert "--oat-c applies to .ulg/.bin/.log logs only; f.csv is a flight CSV" in \
+    assert "--oat-c applies to .ulg/.bin/.log/.tlog logs only; f.csv is a flight CSV" in \
         capsys.readouterr().err
     log = write_dataflash_bin(tmp_path / "f.bin", flight)
     assert main(["identify", str(log), "--oat-c", "290"]) == 2

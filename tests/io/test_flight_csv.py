@@ -274,8 +274,8 @@ def test_a_plan_csv_is_named_as_a_plan(tmp_path):
 
 def test_oat_k_is_for_logs_only(tmp_path):
     path = write(tmp_path / "f.csv", columns())
-    with pytest.raises(PitotcalError, match=r"^oat_k applies to \.ulg/\.bin/\.log logs only; "
-                       r"f\.csv is a flight CSV") as info:
+    with pytest.raises(PitotcalError, match=r"^oat_k applies to \.ulg/\.bin/\.log/\.tlog logs "
+                       r"only; f\.csv is a flight CSV") as info:
         read_flight(path, oat_k=288.15)
     assert info.value.param == "oat_k"
 

@@ -199,8 +199,9 @@ def _truncated(src, tmp_path, n_bytes, name):
 ERRORS = [  # (what, make(tmp_path, flight) -> path, message regex)
     ("unknown extension", lambda d, f: write_dataflash_text(d / "x.txt", f),
      r"x\.txt: unknown log extension '\.txt'"),
-    ("telemetry log", lambda d, f: (d / "x.tlog").write_bytes(b"0" * 64) and d / "x.tlog",
-     r"x\.tlog: MAVLink telemetry logs \(\.tlog\) are not supported"),
+    ("telemetry log of no messages",
+     lambda d, f: (d / "x.tlog").write_bytes(b"0" * 64) and d / "x.tlog",
+     r"x\.tlog: no MAVLink messages in the telemetry log; truncated or corrupt"),
     ("missing file", lambda d, f: d / "none.bin", r"none\.bin: no such file"),
     ("empty file", lambda d, f: _truncated(write_dataflash_bin(d / "a.bin", f), d, 0, "e.bin"),
      r"e\.bin: empty file"),

@@ -8,15 +8,16 @@ def add_parser(subparsers):
     from .common import add_reading_arguments
 
     p = subparsers.add_parser(
-        "convert", help="convert a PX4 .ulg or ArduPilot .bin/.log to a flight CSV",
-        description="Read a PX4 ULog (.ulg) or ArduPilot DataFlash log (.bin binary, .log text), "
+        "convert", help="convert a PX4 .ulg, ArduPilot .bin/.log or MAVLink .tlog to a flight CSV",
+        description="Read a PX4 ULog (.ulg), an ArduPilot DataFlash log (.bin binary, .log text) "
+                    "or a MAVLink telemetry log (.tlog), "
                     "put GPS velocity, static pressure and temperature on the airspeed sensor's "
                     "time base, cut the GPS-invalid parts and what the autopilot did not fly "
                     "(its landed/armed state, take-off and landing rolls), and write the flight "
                     "CSV ({columns}; gps_vd_mps and alt_m when the log has them). "
                     "Comment lines name the source, the firmware, every conversion and cut, and "
                     "the autopilot's own wind and airspeed ratio/scale.")
-    p.add_argument("log", metavar="LOG", help="log file: .ulg, .bin or .log")
+    p.add_argument("log", metavar="LOG", help="log file: .ulg, .bin, .log or .tlog")
     p.add_argument("-o", "--output", required=True, metavar="FLIGHT.csv",
                    help="flight CSV to write")
     add_reading_arguments(p)

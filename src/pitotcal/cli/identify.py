@@ -25,13 +25,14 @@ def add_parser(subparsers):
 
     p = subparsers.add_parser(
         "identify", help="identify the pressure error and the wind from a flight",
-        description="Read a flight CSV (or a .ulg/.bin/.log autopilot log), identify the "
-                    "pressure-error model and the wind by the output-error method, print a "
+        description="Read a flight CSV (or a .ulg/.bin/.log/.tlog autopilot log), identify the "
+                    "pressure-error model and the wind by the output-error method (a log's two or "
+                    "more airspeed sensors jointly: one wind, one calibration each), print a "
                     "summary in knots and degrees with 2-sigma bounds, and optionally write the "
                     "result as JSON and the calibration figure. The input is never modified.")
     p.add_argument("flight", metavar="FLIGHT", nargs="?",
                    help="flight CSV (columns time_s, qc_pa, gps_vn_mps, gps_ve_mps, and rho_kgm3 "
-                        "or ps_pa + oat_k) or a .ulg/.bin/.log autopilot log")
+                        "or ps_pa + oat_k) or a .ulg/.bin/.log/.tlog autopilot log")
     p.add_argument("--model", default="inverse", metavar="NAME",
                    help="pressure-error structure: inverse, constant, linear, or auto (choose by "
                         "information criterion and list all candidates); mach-spline: a jet's "
@@ -68,6 +69,22 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
+    _add_params_and_live(p)
+    add_budget_arguments(p, _help_constants)
+    # --- the GPS receiver's time-correlated velocity error, stated ---
+    gps = p.add_argument_group("GPS velocity error (a known term of the bounds)")
+    gps.add_argument("--gps-error-sigma-mps", type=float, default=None, metavar="SIGMA",
+                     help="the GPS receiver's slowly varying velocity error per component, "
+                          "m/s (first-order Gauss-Markov; e.g. 0.05 from its data sheet); "
+                          "counted in the bounds, because the residuals cannot show it (it "
+                          "looks like wind); with --gps-error-tau-s; default: none stated")
+    gps.add_argument("--gps-error-tau-s", type=float, default=None, metavar="S",
+                     help="its correlation time, s (e.g. 30); with --gps-error-sigma-mps")
+    p.set_defaults(run=run)
+
+
+def _add_params_and_live(p):
+    """The autopilot-parameter and the live-stream option groups."""
     # the airspeed parameter an autopilot loads (estimation.reporting.autopilot_params)
     g = p.add_argument_group("autopilot parameters")
     g.add_argument("--params", metavar="OUT", default=None,
@@ -94,17 +111,6 @@ def add_parser(subparsers):
     live.add_argument("--target-2sigma-kt", type=float, default=1.0, metavar="KT",
                       help="live: say when the 2-sigma of dV at the middle airspeed is at most "
                            "KT, so the maneuver can end (default %(default)s)")
-    add_budget_arguments(p, _help_constants)
-    # --- the GPS receiver's time-correlated velocity error, stated ---
-    gps = p.add_argument_group("GPS velocity error (a known term of the bounds)")
-    gps.add_argument("--gps-error-sigma-mps", type=float, default=None, metavar="SIGMA",
-                     help="the GPS receiver's slowly varying velocity error per component, "
-                          "m/s (first-order Gauss-Markov; e.g. 0.05 from its data sheet); "
-                          "counted in the bounds, because the residuals cannot show it (it "
-                          "looks like wind); with --gps-error-tau-s; default: none stated")
-    gps.add_argument("--gps-error-tau-s", type=float, default=None, metavar="S",
-                     help="its correlation time, s (e.g. 30); with --gps-error-sigma-mps")
-    p.set_defaults(run=run)
 
 
 def _help_constants():
@@ -151,9 +157,8 @@ def run(args):
     import warnings
 
     from pitotcal.core.checks import choice
-    from pitotcal.core.errors import PitotcalError
     from pitotcal.core.models import MODELS
-    from pitotcal.estimation import identify
+    from pitotcal.estimation.identification.multi_sensor import sensors_record, sensors_summary
     from pitotcal.estimation.reporting.budget_tables import budget_summary
     from pitotcal.io import is_log_file
     from pitotcal.io.jsonfile import write_json
@@ -166,27 +171,17 @@ def run(args):
     plot_path = _checked_outputs(args, source)
     sensors = sensor_options(args)
     inputs = None if args.no_budget else budget_inputs(args, sensors)
-    flight, autopilot, current = _read(args, source)
-    result = identify(flight, model=args.model, air=args.air,
-                      gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
-                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
-    budget = result.budget
+    flight, autopilot, current, flights, results = _identify_all(args, source, sensors, inputs)
+    result, budget = results[0], results[0].budget
 
     # every file is written before anything is printed, so a reader that goes away early
     # (`| head`) never costs a file
-    params, refused = None, None
-    if args.params is not None:
-        arm_m = sensors[0].get("probe_arm_m", 0.0)
-        if arm_m:           # the recommendation refits: the data corrected as the result was
-            from pitotcal.estimation.identification.budget import lever_arm_corrected
-            flight = lever_arm_corrected(flight, result, arm_m)
-        try:
-            params = _write_params(args, flight, autopilot, current)
-        except PitotcalError as exc:        # said after the summary
-            refused = exc
+    params, refused, per_sensor = (None, None, None) if args.params is None else \
+        _recommend(args, flights, result, sensors, autopilot, current)
     if args.json is not None:       # the record, with the path as given (a log's names the file)
         write_json(args.json, {**result.to_dict(), "source": str(source),
-                               **_params_record(args, params, refused)})
+                               **_params_record(args, params, refused),
+                               **sensors_record(results, flights, per_sensor)})
     if plot_path is not None:
         _write_plot(plot_path, result, budget)
 
@@ -197,6 +192,7 @@ def run(args):
     print(result.summary())
     if budget is not None:
         print("\n" + budget_summary(result, budget))
+    print(sensors_summary(results, flights), end="")      # a log's other airspeed sensors
     if not result.converged:
         warnings.warn(f"{source}: the solver did not converge ({result.message}); the numbers "
                       "are not a calibration", stacklevel=2)
@@ -204,9 +200,12 @@ def run(args):
         print(f"\nWrote {args.json}")
     if plot_path is not None:
         print(f"{'' if args.json else chr(10)}Wrote {plot_path}")
+    if per_sensor is not None:      # several sensors: each one's, then any refusal
+        from pitotcal.estimation.reporting.autopilot_params import sensor_params_text
+        print(sensor_params_text(per_sensor, args.params))
     if refused is not None:
         raise refused
-    if params is not None:
+    if params is not None and per_sensor is None:
         _print_params(params, args.params)
     return 0
 
@@ -240,6 +239,44 @@ def _print_windows(flight):
     text = windows_text(flight.reading)
     if text:
         print("\n".join(f"  {line}" for line in text.splitlines()))
+
+
+def _identify_all(args, source, sensors, inputs):
+    """(flight, autopilot, current parameters, every sensor's flight, their results): one
+    sensor as `identify`; a log with two or more airspeed sensors fitted jointly, one wind."""
+    from pitotcal.estimation import identify, identify_sensors
+    from pitotcal.io.sensors import other_sensor_flights
+
+    flight, autopilot, current = _read(args, source)
+    arm_m = sensors[0].get("probe_arm_m", 0.0)
+    flights = [flight, *other_sensor_flights(source, flight, csv_columns=args.columns, single_only={
+        "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m})]
+    fit = (identify_sensors(flights, model=args.model, air=args.air, budget=inputs,
+                            gps_noise_std_mps=args.gps_noise_mps) if len(flights) > 1 else
+           [identify(flight, model=args.model, air=args.air, budget=inputs, probe_arm_m=arm_m,
+                     gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))])
+    return flight, autopilot, current, flights, fit
+
+
+def _recommend(args, flights, result, sensors, autopilot, current):
+    """(recommendation, refusal, per sensor) with --params: the first sensor's, and with
+    several sensors each one's (`recommend_sensors`, written to one file)."""
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation.reporting.autopilot_params import recommend_sensors
+
+    if len(flights) > 1:
+        per = recommend_sensors(flights, autopilot, current, air=args.air, path=args.params,
+                                misfit_tolerance_kt=args.misfit_tolerance_kt,
+                                gps_noise_std_mps=args.gps_noise_mps)
+        return per[0][0], next((exc for _, exc in per if exc is not None), None), per
+    flight, arm_m = flights[0], sensors[0].get("probe_arm_m", 0.0)
+    if arm_m:           # the recommendation refits: the data corrected as the result was
+        from pitotcal.estimation.identification.budget import lever_arm_corrected
+        flight = lever_arm_corrected(flight, result, arm_m)
+    try:
+        return _write_params(args, flight, autopilot, current), None, None
+    except PitotcalError as exc:        # said after the summary
+        return None, exc, None
 
 
 def _checked_outputs(args, source):

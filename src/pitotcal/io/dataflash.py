@@ -4,6 +4,8 @@ pymavlink's ``mavutil.mavlink_connection`` reads both forms. Messages read, with
 names of older (3.x) and newer (4.x) firmware:
 
 - ``ARSP`` (first sensor; instance ``I == 0`` where the field exists): ``DiffPress`` (Pa).
+  Further sensors (``ARSP`` with ``I`` = 1, ...; older logs ``ASP2``) are kept apart for the
+  joint fit of several sensors (`pitotcal.io.sensors`).
   A log with ``Airspeed`` but no ``DiffPress`` is converted with ArduPilot's own relation
   EAS = sqrt(ARSPD_RATIO · Δp), i.e. q_ci = EAS² / ARSPD_RATIO, with a warning.
 - ``BARO`` (instance 0): ``Press`` (Pa) and ``Temp`` (°C).
@@ -72,6 +74,7 @@ class _Collector:
 
 _WANTED = {
     "ARSP": ("I", "Airspeed", "DiffPress", "Temp", "Health", "H"),
+    "ASP2": ("Airspeed", "DiffPress", "Temp"),
     "STAT": ("isFlying", "Armed"),
     "BARO": ("I", "Press", "Temp", "Health", "H"),
     "GPS": ("I", "Status", "Spd", "GCrs", "VZ", "VelN", "VelE", "VelD", "Alt"),
@@ -165,6 +168,7 @@ def read_dataflash_streams(path):
         s.warn(f"{name}: skipped {skipped} corrupt bytes in the log", stacklevel=4)
     s.autopilot = firmware or "ArduPilot (firmware version not logged)"
     arsp = _read_pressure(data, params, t0, s, name)
+    _read_other_sensors(data, t0, s)
     _read_static_and_temperature(data, arsp, t0, s)
     _read_gps(data, t0, s)
     _read_flight_state(data, params, t0, s)
@@ -191,6 +195,8 @@ def _read_pressure(data, params, t0, s, name):
     ratio = params.get("ARSPD_RATIO")
     if ratio is not None:
         s.airspeed_scale["ARSPD_RATIO"] = float(ratio)
+    if params.get("ARSPD2_RATIO") is not None:      # the second sensor's
+        s.airspeed_scale["ARSPD2_RATIO"] = float(params["ARSPD2_RATIO"])
     if "DiffPress" in arsp:
         s.qci_pa = arsp["DiffPress"]
         s.pressure_source = "ARSP.DiffPress (Pa)"
@@ -207,6 +213,20 @@ def _read_pressure(data, params, t0, s, name):
     else:
         raise FlightDataError(f"{name}: ARSP has neither DiffPress nor Airspeed")
     return arsp
+
+
+def _read_other_sensors(data, t0, s):
+    """The airspeed sensors beyond the first: ARSP instances I > 0, or an older log's ASP2,
+    each with a differential pressure (`LogStreams.other_sensors`)."""
+    arsp = data.get("ARSP")
+    if arsp is not None and "I" in arsp and "DiffPress" in arsp:
+        for inst in np.unique(arsp["I"][np.isfinite(arsp["I"])])[1:]:
+            rows = arsp["I"] == inst
+            s.other_sensors.append((arsp["t"][rows] - t0, arsp["DiffPress"][rows],
+                                    f"ARSP[{inst:g}].DiffPress (Pa)"))
+    asp2 = data.get("ASP2")
+    if not s.other_sensors and asp2 is not None and asp2["t"].size and "DiffPress" in asp2:
+        s.other_sensors.append((asp2["t"] - t0, asp2["DiffPress"], "ASP2.DiffPress (Pa)"))
 
 
 def _read_static_and_temperature(data, arsp, t0, s):

@@ -1,4 +1,5 @@
-"""Autopilot flight logs as a `Flight`: PX4 ULog (`.ulg`) and ArduPilot DataFlash (`.bin`, `.log`).
+"""Autopilot flight logs as a `Flight`: PX4 ULog (`.ulg`), ArduPilot DataFlash (`.bin`, `.log`)
+and MAVLink telemetry logs (`.tlog`, `pitotcal.io.tlog`).
 
 `read_log(path)` returns the `Flight` that `identify` needs; `load_log(path)` returns it inside a
 `FlightLog` with what the autopilot itself estimated (its wind, its airspeed ratio or scale) for
@@ -101,7 +102,8 @@ def read_log(path, start_s=None, end_s=None, **options):
     Parameters
     ----------
     path : str or Path
-        ``.ulg`` (PX4), ``.bin`` or ``.log`` (ArduPilot DataFlash, binary or text).
+        ``.ulg`` (PX4), ``.bin`` or ``.log`` (ArduPilot DataFlash, binary or text), ``.tlog``
+        (MAVLink telemetry log).
     start_s, end_s : float, optional
         Window in seconds since the start of the log (either may be None).
     **options
@@ -216,10 +218,6 @@ def _kelvin(name, value):
 def _read_streams(path):
     """The raw `LogStreams` of a log file, by its extension."""
     name, suffix = path.name, path.suffix.lower()
-    if suffix == ".tlog":
-        raise FlightDataError(f"{name}: MAVLink telemetry logs (.tlog) are not supported: their "
-                              "message times are radio arrival times; use the autopilot's "
-                              "DataFlash log (.bin) of the same flight")
     if suffix not in LOG_EXTENSIONS:
         kind = csv_kind(path) if path.is_file() else None
         if kind == "flight":
@@ -236,6 +234,9 @@ def _read_streams(path):
     if suffix == ".ulg":
         from .ulog import read_ulog_streams
         return read_ulog_streams(path)
+    if suffix == ".tlog":
+        from .tlog import read_tlog_streams
+        return read_tlog_streams(path)
     from .dataflash import read_dataflash_streams
     return read_dataflash_streams(path)
 
@@ -422,6 +423,9 @@ def _meta(s, name, kt, window, temp_source, opt, excluded_text, wind):
     if gate:
         meta["min_airspeed_mps"] = f"{gate:g} ({gate_source}): take-off and landing gate"
     meta["excluded"] = excluded_text
+    if s.other_sensors:      # the others are read by pitotcal.io.sensors
+        meta["airspeed_sensors"] = "; ".join([s.pressure_source]
+                                             + [src for _, _, src in s.other_sensors])
     for key, value in s.airspeed_scale.items():
         meta[f"autopilot_{key}"] = f"{value:.6g}"
     if wind is not None and wind.time_s.size:

@@ -18,7 +18,8 @@ from pitotcal.core.errors import PitotcalError
 from .atomic import atomic_open
 
 __all__ = ["QGC_REAL32", "read_flight_and_parameters", "read_qgc_params",
-           "write_ardupilot_params", "write_qgc_params"]
+           "write_ardupilot_param_set", "write_ardupilot_params", "write_qgc_param_set",
+           "write_qgc_params"]
 
 QGC_REAL32 = 9          # MAV_PARAM_TYPE_REAL32
 ARDUPILOT_RATIO = "ARSPD_RATIO"
@@ -49,7 +50,8 @@ def read_flight_and_parameters(path, start_s=None, end_s=None, *, oat_k=None,
                        windows=windows)
         params = dict(log.airspeed_scale)
         suffix = log_suffix(path) or Path(path).suffix.lower()
-        autopilot = "PX4" if suffix == ".ulg" else "ArduPilot"
+        # a telemetry log says which autopilot sent it (its format names it)
+        autopilot = "PX4" if suffix == ".ulg" or "PX4" in log.log_format else "ArduPilot"
         flight = with_static_air(log.flight, temp_recovery=temp_recovery, rh_pct=rh_pct)
         reading = {"start_s": start_s, "end_s": end_s, "oat_k": oat_k,
                    "temp_recovery": temp_recovery, "rh_pct": rh_pct}
@@ -91,6 +93,31 @@ def write_qgc_params(path, name, value, comments=(), vehicle_id=1, component_id=
     row = f"{vehicle_id}\t{component_id}\t{name}\t{value:.6f}\t{QGC_REAL32}"
     with atomic_open(path, "w") as fh:
         fh.write("\n".join(header + [row]) + "\n")
+    return path
+
+
+def write_ardupilot_param_set(path, entries):
+    """`write_ardupilot_params` of several parameters in one file: `entries` are
+    (name, value, comments), each parameter's comments before its line. Returns the path."""
+    lines = []
+    for name, value, comments in entries:
+        lines += [f"# {c}" for c in comments] + [f"{name},{value:.6f}"]
+    with atomic_open(path, "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    return path
+
+
+def write_qgc_param_set(path, entries, vehicle_id=1, component_id=1):
+    """`write_qgc_params` of several parameters in one file: `entries` are (name, value,
+    comments), the comments in the header. Returns the path."""
+    header = ["# Onboard parameters for Vehicle 1", "#", "# Stack: PX4 Pro"]
+    for _, _, comments in entries:
+        header += [f"# {c}" for c in comments]
+    rows = [f"{vehicle_id}\t{component_id}\t{name}\t{value:.6f}\t{QGC_REAL32}"
+            for name, value, _ in entries]
+    with atomic_open(path, "w") as fh:
+        fh.write("\n".join(header + ["#", "# Vehicle-Id Component-Id Name Value Type"] + rows)
+                 + "\n")
     return path
 
 

@@ -14,7 +14,7 @@ import numpy as np
 __all__ = ["LOG_EXTENSIONS", "LogStreams", "captured_output"]
 
 # The autopilot log formats pitotcal reads (anything else is read as a flight CSV).
-LOG_EXTENSIONS = (".ulg", ".bin", ".log")
+LOG_EXTENSIONS = (".ulg", ".bin", ".log", ".tlog")
 
 
 @contextlib.contextmanager
@@ -94,6 +94,8 @@ class LogStreams:
     throttle_t: np.ndarray | None = None
     throttle: np.ndarray | None = None
     throttle_source: str = ""
+    # airspeed sensors beyond the first, each (time s, q_ci Pa, source): `pitotcal.io.sensors`
+    other_sensors: list = field(default_factory=list)
     conversions: list = field(default_factory=list)
     warnings: list = field(default_factory=list)
 

@@ -143,6 +143,22 @@ def _read_pressure(ulog, t0, s, name):
     else:
         raise FlightDataError(f"{name}: no airspeed data (differential_pressure or airspeed "
                               "topic) in the log")
+    if s.pressure_source.startswith("differential_pressure"):
+        _read_other_sensors(ulog, t0, s)
+
+
+def _read_other_sensors(ulog, t0, s):
+    """The differential_pressure instances beyond the first (multi_id 1, 2...): further
+    airspeed sensors (`LogStreams.other_sensors`)."""
+    found = sorted((d for d in ulog.data_list if d.name == "differential_pressure"),
+                   key=lambda d: d.multi_id)
+    for d in found[1:]:
+        field, dp_pa = _first_field(d.data, ["differential_pressure_pa",
+                                             "differential_pressure_raw_pa",
+                                             "differential_pressure_filtered_pa"])
+        if dp_pa is not None:
+            s.other_sensors.append((_times_s(d.data, t0), np.asarray(dp_pa, float),
+                                    f"differential_pressure[{d.multi_id}].{field} (Pa)"))
 
 
 def _read_static_and_temperature(ulog, t0, s):
@@ -252,7 +268,7 @@ def _read_autopilot_estimates(ulog, t0, s):
         if scale is not None and np.any(scale > 0):
             s.airspeed_scale[f"{wname}.{sfield} (last)"] = float(scale[scale > 0][-1])
     # the scale, and the airspeed sensor model PX4 compensates its IAS with before scaling
-    for pname in ("ASPD_SCALE", "ASPD_SCALE_1", "SENS_EN_SDP3X", "CAL_AIR_CMODEL",
-                  "CAL_AIR_TUBELEN", "CAL_AIR_TUBED_MM"):
+    for pname in ("ASPD_SCALE", "ASPD_SCALE_1", "ASPD_SCALE_2", "SENS_EN_SDP3X",
+                  "CAL_AIR_CMODEL", "CAL_AIR_TUBELEN", "CAL_AIR_TUBED_MM"):
         if pname in ulog.initial_parameters:
             s.airspeed_scale[pname] = float(ulog.initial_parameters[pname])

@@ -1,0 +1,110 @@
+"""`pitotcal identify` of logs with two airspeed sensors (ArduPilot ARSP instances 0/1, PX4
+differential_pressure instances, a tlog's SCALED_PRESSURE2): one shared wind, each sensor's
+calibration and parameter; and a MAVLink telemetry log calibrated and converted."""
+
+import json
+import warnings
+
+import pytest
+from logwriters import write_dataflash_bin, write_tlog, write_ulog
+from synthetic import two_sensor_flights
+
+from pitotcal.cli import main
+from pitotcal.core.units import RHO0_KGM3
+from pitotcal.io.param_files import read_qgc_params
+
+K_A, K_B = (0.02, -15.0), (-0.03, 10.0)
+
+
+@pytest.fixture(scope="module")
+def two():
+    """300 s at 10 Hz in 0.3 m/s turbulence; sensor a k = K_A, b = K_B (inverse model)."""
+    return two_sensor_flights(seed=2, n=3000, rate_hz=10.0, turbulence_mps=0.3, k_a=K_A,
+                              k_b=K_B)
+
+
+def _true_ratio_of_ratios(flight):
+    """ARSPD_RATIO of sensor a over sensor b's, 2 / (rho0 (1 - f)) at the median q_ci: the
+    density (and --oat-c's offset from it) cancels."""
+    import numpy as np
+
+    q = float(np.median(flight.qci_pa))
+    return (1.0 - (K_B[0] + K_B[1] / q)) / (1.0 - (K_A[0] + K_A[1] / q))
+
+
+def _run(argv):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return main(argv)
+
+
+def test_two_ardupilot_sensors_share_the_wind_and_get_a_ratio_each(two, tmp_path, capsys):
+    fa, fb, _ = two
+    log = write_dataflash_bin(tmp_path / "two.bin", fa, second=fb.qci_pa, ratio=1.9,
+                              second_ratio=2.1)
+    rec, parm = tmp_path / "r.json", tmp_path / "new.parm"
+    assert _run(["identify", str(log), "--oat-c", "15", "--no-budget", "--json", str(rec),
+                 "--params", str(parm)]) == 0
+    out = capsys.readouterr().out
+    assert "Airspeed sensor 2 (ARSP[1].DiffPress (Pa)" in out
+    doc = json.loads(rec.read_text())
+    a, b = doc["sensors"]
+    assert (a["sensor"], b["sensor"]) == (1, 2) and a["qc_source"] == "ARSP.DiffPress (Pa)"
+    # the top level stays the first sensor's record, every key kept
+    assert doc["parameters"] == a["parameters"] and doc["autopilot_parameter"]["name"] == \
+        "ARSPD_RATIO"
+    for key in ("wind_speed_mps", "wind_from_deg"):
+        assert a["parameters"][key]["value"] == b["parameters"][key]["value"]
+    ra, rb = a["autopilot_parameter"], b["autopilot_parameter"]
+    assert (ra["name"], rb["name"]) == ("ARSPD_RATIO", "ARSPD2_RATIO")
+    assert (ra["current"], rb["current"]) == (pytest.approx(1.9), pytest.approx(2.1))
+    text = parm.read_text()
+    assert f"ARSPD_RATIO,{ra['value']:.6f}" in text and f"ARSPD2_RATIO,{rb['value']:.6f}" in text
+    assert "pitotcal: ARSPD2_RATIO" in text
+    # the two calibrations differ as the truth does (1.030): the common turbulence cancels
+    assert ra["value"] / rb["value"] == pytest.approx(_true_ratio_of_ratios(fa), abs=0.006)
+    # and each is a calibration: 2 / (rho0 (1 - k1)) of its own constant k1
+    assert ra["value"] == pytest.approx(2.0 / RHO0_KGM3 / (1.0 - doc["sensors"][0]
+                                        ["parameters"]["k1"]["value"]), rel=0.03)
+
+
+def test_two_px4_sensors_get_a_scale_each(two, tmp_path, capsys):
+    fa, fb, _ = two
+    log = write_ulog(tmp_path / "two.ulg", fa, second=fb.qci_pa)
+    rec, parm = tmp_path / "r.json", tmp_path / "new.params"
+    assert _run(["identify", str(log), "--oat-c", "15", "--no-budget", "--json", str(rec),
+                 "--params", str(parm)]) == 0
+    doc = json.loads(rec.read_text())
+    assert [s["qc_source"].split(".")[0] for s in doc["sensors"]] == \
+        ["differential_pressure", "differential_pressure[1]"]
+    params = read_qgc_params(parm)
+    assert set(params) == {"ASPD_SCALE_1", "ASPD_SCALE_2"}
+    # scale = V_c / IAS = 1 / sqrt(1 - f): the square of their ratio is the ratio's
+    assert (params["ASPD_SCALE_1"] / params["ASPD_SCALE_2"]) ** 2 == \
+        pytest.approx(_true_ratio_of_ratios(fa), abs=0.006)
+
+
+def test_tlog_with_two_sensors_identifies_and_converts(two, tmp_path, capsys):
+    fa, fb, _ = two
+    log = write_tlog(tmp_path / "two.tlog", fa, second=fb.qci_pa, params={"ARSPD_RATIO": 1.9})
+    rec = tmp_path / "r.json"
+    assert _run(["identify", str(log), "--no-budget", "--json", str(rec)]) == 0
+    doc = json.loads(rec.read_text())
+    assert [s["qc_source"] for s in doc["sensors"]] == [
+        "SCALED_PRESSURE.press_diff (hPa)", "SCALED_PRESSURE2.press_diff (hPa)"]
+    csv = tmp_path / "c.csv"
+    assert _run(["convert", str(log), "-o", str(csv)]) == 0
+    head = csv.read_text()[:3000]
+    assert "# qc_source: SCALED_PRESSURE.press_diff (hPa)" in head
+    assert "# autopilot_ARSPD_RATIO: 1.9" in head
+    assert "# airspeed_sensors: SCALED_PRESSURE.press_diff (hPa); SCALED_PRESSURE2" in head
+    # the converted CSV holds the first sensor: identified as it alone
+    assert _run(["identify", str(csv), "--no-budget", "--json", str(rec)]) == 0
+    assert "sensors" not in json.loads(rec.read_text())
+
+
+def test_tlog_without_airspeed_exits_2_in_one_line(two, tmp_path, capsys):
+    log = write_tlog(tmp_path / "nodp.tlog", two[0], press_diff=False)
+    assert _run(["identify", str(log), "--no-budget"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "SCALED_PRESSURE.press_diff is zero in all" in err[0]
