@@ -36,7 +36,7 @@ __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_D
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None,
-             probe_arm_m=0.0):
+             probe_arm_m=0.0, wind="auto", wind_knot_s=None):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -71,6 +71,12 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     probe_arm_m : float
         Lateral position of the pitot probe, m (right wing +), corrected in the data
         (`_fit_corrected`); the record's `reading` keeps it. Default 0.
+    wind : {"auto", "constant", "drifting"}
+        The wind model (`estimation.identification.wind_drift`): a constant wind, a wind
+        drifting slowly in time (piecewise linear, knots every `wind_knot_s`), or "auto"
+        (the default): drifting when a Wald test of no drift rejects it at 1 %.
+    wind_knot_s : float, optional
+        Knot spacing of the drifting wind, s (default `wind_drift.DEFAULT_KNOT_S`, 300 s).
 
     Returns
     -------
@@ -112,7 +118,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     inputs = budget_inputs(budget)
     arm_m = checks.number("probe_arm_m", probe_arm_m, -50.0, 50.0)
     options = {"air": air, "gps_noise_std_mps": gps_noise_std_mps, "ipopt_options": ipopt_options,
-               "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s}
+               "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s,
+               "wind": wind, "wind_knot_s": wind_knot_s}
     flight, result = _fit_corrected(flight, model, arm_m, options)
     refit = functools.partial(fit, model=model, **options)
     result, flight = _at_calibrated_mach(result, flight, refit)

@@ -30,7 +30,7 @@ def to_dict(result):
         dv_U_kt when there is a budget), noise_std_pa, gps_noise_std_mps, candidates,
         criterion, timing_s, air_data, consistency (when it ran), static_source (compressible),
         source, n_dropped, uncertainty_budget (with a budget), noise_model (absent for a record
-        too short for it), gps_error, reading.
+        too short for it), gps_error, reading, wind_model and wind_track (when fitted).
     """
     from .view import correction_table
 
@@ -71,6 +71,8 @@ def to_dict(result):
     if result.monitor_noise is not None:       # absent for a record too short for it
         out["noise_model"] = result.monitor_noise
     out.update(gps_error=result.gps_error, reading=result.reading)
+    if result.wind_model is not None:       # docs/interfaces.md §3, the wind model
+        out.update(wind_model=result.wind_model, wind_track=result.wind_track)
     return json_ready(out)
 
 
