@@ -29,6 +29,7 @@ from .fit import (
     track_spread_deg,
 )
 from .view import correction_table
+from .wind_drift import without_drift
 
 __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG",
            "TEMPERATURE_TOL_K", "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
@@ -87,7 +88,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         and the result record's products, each computed once here: `monitor_noise` (the
         residuals' noise model `pitotcal monitor` designs from), `static_fit` (the measured
         static-error fit, with a reference static pressure), `budget`, `gps_error` (the
-        statement), `reading` (how `read_flight` read the flight), `source`, `n_dropped`.
+        statement), `reading` (how `read_flight` read the flight), `source`, `n_dropped`;
+        `wind_model` (constant or drifting, and the test that chose it) and `wind_track`.
         `to_dict()` is the record `pitotcal identify --json` writes.
 
     Raises
@@ -207,6 +209,8 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
     result = _with_warning(result, _incompressible_note(result, flight))
     if budget is None:
         return result
+    if result.drift is not None:        # the budget perturbs the flight the fit solved
+        flight = without_drift(flight, *result.drift)
     try:
         return dataclasses.replace(
             result, budget=uncertainty_budget(flight, result, budget, air=air))

@@ -87,6 +87,9 @@ class IdentificationResult:
     wind_track : dict or None
         The wind along the record: {time_s, speed_mps, from_deg, speed_2sigma_mps,
         from_2sigma_deg[, segment]} (two points for a constant wind).
+    drift : (DriftBasis, ndarray) or None
+        The fitted drift of a drifting wind (`wind_drift.without_drift` takes it out of a
+        flight's GPS velocity); None for a constant wind.
     """
 
     model: str
@@ -124,6 +127,7 @@ class IdentificationResult:
     n_dropped: int = 0
     wind_model: dict | None = None
     wind_track: dict | None = None
+    drift: tuple | None = None
 
     # --- derived quantities -------------------------------------------------------------
     @property

@@ -38,8 +38,10 @@ __all__ = ["DEFAULT_KNOT_S", "DRIFT_MATTERS_MPS", "DRIFT_TEST_ALPHA", "WIND_MODE
 WIND_MODES = ("auto", "constant", "drifting")
 # Knot spacing of the drift, s: long against an orbit (1-3 min at 40-60 m/s on a 600-900 m
 # circle), so within one knot interval the heading turns through every direction and the
-# wind still separates from the calibration; a 15-minute flight gets 3 intervals.
+# wind still separates from the calibration; a 15-minute flight gets 3 intervals. A flight
+# that turns more slowly gets knots `ORBITS_PER_KNOT` of its revolutions apart.
 DEFAULT_KNOT_S = 300.0
+ORBITS_PER_KNOT = 2.0
 MIN_KNOT_S = 30.0
 # Test level of d = 0: a false drift on 1 % of constant-wind flights when the bounds are honest
 DRIFT_TEST_ALPHA = 0.01
@@ -88,9 +90,25 @@ class DriftBasis:
         return full - self.means
 
 
+def default_knot_s(flight):
+    """The default knot spacing of `flight`, s: `DEFAULT_KNOT_S`, or `ORBITS_PER_KNOT` times
+    the time its ground track takes to turn through 360 deg when that is longer."""
+    t = flight.time_s
+    if t.size < 2 or t[-1] <= t[0]:
+        return DEFAULT_KNOT_S
+    # course every second: GPS noise summed over every sample would add turns of its own
+    grid = np.arange(t[0], t[-1], 1.0)
+    course = np.unwrap(np.arctan2(np.interp(grid, t, flight.gps_ve_mps),
+                                  np.interp(grid, t, flight.gps_vn_mps)))
+    turns = float(np.sum(np.abs(np.diff(course)))) / (2.0 * np.pi)
+    if turns <= 0:
+        return DEFAULT_KNOT_S
+    return max(DEFAULT_KNOT_S, ORBITS_PER_KNOT * (t[-1] - t[0]) / turns)
+
+
 def drift_basis(time_s, segment, knot_s):
-    """The `DriftBasis` of a record: knots every about `knot_s` s in each window (at least
-    its two ends: a linear drift), the last column dropped (the centred hats sum to zero)."""
+    """The `DriftBasis` of a record: knots about `knot_s` s apart or more in each window (at
+    least its two ends: a linear drift), the last column dropped (centred hats sum to zero)."""
     seg = np.zeros(time_s.size, dtype=int) if segment is None else np.asarray(segment, int)
     knots = []
     for s in range(int(seg.max()) + 1):
@@ -98,7 +116,7 @@ def drift_basis(time_s, segment, knot_s):
         if t.size < 2 or t[-1] <= t[0]:
             knots.append(np.array([t[0] if t.size else 0.0, (t[0] if t.size else 0.0) + 1.0]))
             continue
-        n_int = max(1, int(round((t[-1] - t[0]) / knot_s)))
+        n_int = max(1, int((t[-1] - t[0]) // knot_s))
         knots.append(np.linspace(t[0], t[-1], n_int + 1))
     raw = DriftBasis(tuple(knots), np.zeros(sum(k.size for k in knots) - 1), float(knot_s))
     means = np.mean(raw.rows(time_s, seg), axis=0)
@@ -106,10 +124,11 @@ def drift_basis(time_s, segment, knot_s):
 
 
 def check_wind_options(wind, knot_s):
-    """(wind, knot_s) checked: a choice of `WIND_MODES` and a knot spacing, s (None: default)."""
+    """(wind, knot_s) checked: a choice of `WIND_MODES` and a knot spacing, s (None: the
+    flight's `default_knot_s`)."""
     checks.choice("wind", wind, WIND_MODES)
     if knot_s is None:
-        return wind, DEFAULT_KNOT_S
+        return wind, None
     return wind, checks.number("wind_knot_s", knot_s, MIN_KNOT_S, 1e6)
 
 
@@ -231,6 +250,7 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
         chosen = "option" if wind == "constant" else "the constant fit did not converge"
         return _constant(result, None, knot_s, chosen), notes
     kept = _kept(flight, result)
+    knot_s = default_knot_s(kept) if knot_s is None else knot_s
     basis = drift_basis(kept.time_s, kept.segment, knot_s)
     model = get_model(result.model)
     sigma = result.gps_noise_std_mps if gps_noise_std_mps is None else gps_noise_std_mps
@@ -256,7 +276,7 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
     chosen = "option" if wind == "drifting" else "auto: Wald test"
     out = dataclasses.replace(out, wind_model=_model_record("drifting", knot_s, test, chosen,
                                                             basis),
-                              wind_track=track)
+                              wind_track=track, drift=(basis, d))
     note = drift_note(out, track, result)
     return out, tuple(notes) + ((note,) if note else ())
 
@@ -283,7 +303,8 @@ def _widened(result, cov):
 
 
 def _model_record(kind, knot_s, test, chosen_by, basis=None):
-    out = {"kind": kind, "knot_s": float(knot_s), "test": test, "chosen_by": chosen_by}
+    out = {"kind": kind, "knot_s": None if knot_s is None else float(knot_s), "test": test,
+           "chosen_by": chosen_by}
     if basis is not None:
         out["n_knots"] = int(sum(k.size for k in basis.knots))
     return out

@@ -53,6 +53,13 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
+    p.add_argument("--wind", default="auto", metavar="MODEL",
+                   help="wind model: constant, drifting (a wind varying slowly in time, "
+                        "piecewise linear between knots) or auto: drifting when a Wald test "
+                        "of no drift rejects it at 1%% (default: auto)")
+    p.add_argument("--wind-knot-s", type=float, default=None, metavar="S",
+                   help="knot spacing of the drifting wind, s (default: 300 s, or two of the "
+                        "flight's orbits when it turns more slowly)")
     # the airspeed parameter an autopilot loads (estimation.reporting.autopilot_params)
     g = p.add_argument_group("autopilot parameters")
     g.add_argument("--params", metavar="OUT", default=None,
@@ -272,7 +279,8 @@ def run(args):
     flight, autopilot, current = _read(args, source)
     result = identify(flight, model=args.model, air=args.air,
                       gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
-                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
+                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0), wind=args.wind,
+                      wind_knot_s=args.wind_knot_s, **_gps_error(args))
     budget = result.budget
 
     # every file is written before anything is printed, so a reader that goes away early
