@@ -52,11 +52,10 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
         temperature `oat_k`, with all the pressure error in the static source (the default,
         `DEFAULT_AIR_DATA`, which `simulate` flies), or the paper's eq. 2, q_c = ½ρV_t²
-        ("incompressible"). A
-        flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
-        an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
-        it instead, and the static and total pressure errors are separated
-        (`estimation.identification.static_source`).
+        ("incompressible"). A flight without `ps_pa` and `oat_k` is fitted incompressible
+        with a warning. With an independent reference static pressure `ps_ref_pa` as well,
+        q_c is predicted from it instead, and the static and total pressure errors are
+        separated (`estimation.identification.static_source`).
     gps_noise_std_mps : float, optional
         GPS velocity noise per component, m/s, for the errors-in-variables correction;
         estimated from the data when None.
@@ -72,12 +71,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     probe_arm_m : float
         Lateral position of the pitot probe, m (right wing +), corrected in the data
         (`_fit_corrected`); the record's `reading` keeps it. Default 0.
-    wind : {"auto", "constant", "drifting"}
-        The wind model (`estimation.identification.wind_drift`): a constant wind, a wind
-        drifting slowly in time (piecewise linear, knots every `wind_knot_s`), or "auto"
-        (the default): drifting when a Wald test of no drift rejects it at 1 %.
-    wind_knot_s : float, optional
-        Knot spacing of the drifting wind, s (default `wind_drift.DEFAULT_KNOT_S`, 300 s).
+    wind, wind_knot_s : {"auto", "constant", "drifting"}, float or None
+        The wind model and a drift's knot spacing, s (`wind_drift.fit_wind`; None: 300 s).
 
     Returns
     -------
@@ -88,8 +83,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         and the result record's products, each computed once here: `monitor_noise` (the
         residuals' noise model `pitotcal monitor` designs from), `static_fit` (the measured
         static-error fit, with a reference static pressure), `budget`, `gps_error` (the
-        statement), `reading` (how `read_flight` read the flight), `source`, `n_dropped`;
-        `wind_model` (constant or drifting, and the test that chose it) and `wind_track`.
+        statement), `reading`, `source`, `n_dropped`, `wind_model` and `wind_track`.
         `to_dict()` is the record `pitotcal identify --json` writes.
 
     Raises
@@ -105,8 +99,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
 
     Notes
     -----
-    A solver that does not converge is not an exception: `success` is False, `message` is
-    IPOPT's status and `warnings` says so.
+    Non-convergence is a result, not an exception: `success` False, IPOPT's status in `message`.
 
     "auto" uses the Bayesian information criterion with an effective sample size (see
     `_identify_auto`).

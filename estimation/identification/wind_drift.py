@@ -373,10 +373,8 @@ def drift_size(track):
 def drift_note(result, track, constant):
     """The warning of a drift that matters (the wind moves more than `DRIFT_MATTERS_MPS`, or
     the ΔV table moves by more than its 2σ against the constant-wind fit), or None."""
-    from .view import correction_table
-
     vec, dspeed, turn = drift_size(track)
-    rows = correction_table(result)
+    rows = result.correction_table()
     vi = np.array([row["vi_kt"] for row in rows])
     band = np.array([row["dv_2sigma_kt"] for row in rows])
     shift = np.abs(np.asarray(result.delta_v_kt(vi)[0]) - np.asarray(constant.delta_v_kt(vi)[0]))
