@@ -211,13 +211,19 @@ def _psd(matrix):
 
 
 def wald_test(d, cov_dd):
-    """{"statistic", "dof", "p_value", "alpha"}: the Wald test of d = 0 with `cov_dd`."""
-    from scipy.stats import chi2
+    """{"statistic", "dof", "p_value", "alpha"}: the Wald test of d = 0 with `cov_dd`.
 
+    d holds a north and an east value per knot, so the degrees of freedom are even and the
+    chi-square tail is closed: exp(-x/2) sum_{j < dof/2} (x/2)^j / j! (no scipy.stats import,
+    0.5 s of a command's start).
+    """
     stat = float(d @ np.linalg.pinv(cov_dd) @ d)
     dof = int(d.size)
+    half = 0.5 * max(stat, 0.0)
+    terms = np.cumprod(np.concatenate([[1.0], half / np.arange(1, dof // 2)]))
+    p_value = float(np.exp(-half) * np.sum(terms)) if dof >= 2 else 1.0
     return {"name": "Wald test of no drift (colored-residual covariance, one exponential)",
-            "statistic": stat, "dof": dof, "p_value": float(chi2.sf(stat, dof)),
+            "statistic": stat, "dof": dof, "p_value": min(p_value, 1.0),
             "alpha": DRIFT_TEST_ALPHA}
 
 

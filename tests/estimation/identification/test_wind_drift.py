@@ -132,3 +132,17 @@ def test_constant_wind_is_chosen_on_constant_wind_flights():
     kinds = [identify(simulate(plan, seed=seed)[0]).wind_model["kind"] for seed in range(60)]
     kinds += [scored(seed, drifting=False)["kind"] for seed in range(40)]
     assert kinds.count("constant") >= 90
+
+
+@pytest.mark.parametrize("dof", [2, 4, 6, 10])
+def test_wald_p_value_is_the_chi_square_tail(dof):
+    from scipy.stats import chi2
+
+    from pitotcal.estimation.identification.wind_drift import wald_test
+
+    for stat in (0.5, 3.0, 12.0, 60.0):
+        d = np.zeros(dof)
+        d[0] = np.sqrt(stat)
+        got = wald_test(d, np.eye(dof))
+        assert got["statistic"] == pytest.approx(stat)
+        assert got["p_value"] == pytest.approx(chi2.sf(stat, dof), rel=1e-10)
