@@ -25,6 +25,7 @@ import dataclasses
 import numpy as np
 
 from pitotcal.core import checks
+from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model
 from pitotcal.core.units import wind_polar
 
@@ -276,9 +277,15 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
     test = wald_test(d, cov[0][p:, p:])
     if wind == "auto" and not test["p_value"] < DRIFT_TEST_ALPHA:
         return _constant(result, test, knot_s, "auto: Wald test"), notes
-    drifting, notes = fit_constant(without_drift(flight, basis, d))
+    if not np.all(np.isfinite(d)):
+        return _fallback(result, test, knot_s, "its fit did not converge", notes)
+    try:
+        drifting, drift_notes = fit_constant(without_drift(flight, basis, d))
+    except PitotcalError as exc:        # the constant wind's calibration stands
+        return _fallback(result, test, knot_s, f"its fit failed: {exc}", notes)
     if not drifting.success:
-        return _constant(result, test, knot_s, "the drifting fit did not converge"), notes
+        return _fallback(result, test, knot_s, "its fit did not converge", notes)
+    notes, model = drift_notes, get_model(drifting.model)
     kept = _kept(without_drift(flight, basis, d), drifting)
     ch = flight_channels(kept, drifting.gps_noise_std_mps, air_data)
     b = basis.rows(kept.time_s, kept.segment)
@@ -291,6 +298,15 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
                               wind_track=track, drift=(basis, d))
     note = drift_note(out, track, result)
     return out, tuple(notes) + ((note,) if note else ())
+
+
+def _fallback(result, test, knot_s, reason, notes):
+    """(the constant-wind result, its warnings and one saying why the drift the test or the
+    option asked for was not fitted)."""
+    note = (f"{result.source}: a drifting wind was called for but not fitted ({reason}); the "
+            "calibration is the constant wind's")
+    return _constant(result, test, knot_s, f"constant: the drift's {reason}"), \
+        tuple(notes) + (note,)
 
 
 def _known(gps_error, time_s):
