@@ -9,15 +9,19 @@ from pitotcal.core.units import G0_MPS2, kt_to_mps
 
 
 def circle_plan(duration_s=240.0, cas_kt=(70.0, 100.0), radius_m=600.0, altitude_m=244.0,
-                wind_speed_mps=5.0, wind_from_deg=270.0, step_s=0.5):
+                wind_speed_mps=5.0, wind_from_deg=270.0, step_s=0.5, sweeps=None):
     """A hand-made plan: a ground circle about the centre flown in the wind, CAS uniform in q
     (the standard CAS law and the isentropic q_c at the ISA altitude, as the planner writes).
+    `sweeps` (a number): q goes up and down that many times instead of once up, as an
+    everyday flight's long loiter varies its speed.
 
     (Independent of the planner, so the simulator tests do not depend on it.)
     """
     t = np.arange(0.0, duration_s + 1e-9, step_s)
     qlo, qhi = (float(qc_from_cas_pa(kt_to_mps(v))) for v in cas_kt)
-    qc = qlo + (qhi - qlo) * t / duration_s
+    phase = t / duration_s if sweeps is None else \
+        1.0 - np.abs(1.0 - 2.0 * ((sweeps * t / duration_s) % 1.0))
+    qc = qlo + (qhi - qlo) * phase
     cas = cas_from_qc_mps(qc)
     tas = tas_from_qc_mps(qc, altitude_m)
     a = np.radians(wind_from_deg)

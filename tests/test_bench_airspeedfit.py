@@ -39,12 +39,13 @@ def test_every_tool_it_has_is_timed_and_scored(run):
 
 def test_the_answers_are_near_the_truth_and_the_drift_is_seen(run):
     """pitotcal's constant-scale fit and AirspeedFit both within 0.6 kt of the true ΔV over the
-    flown speeds; a constant wind is ~2 m/s rms off the drifting one, AirspeedFit's smoothed
-    track within 1 m/s; everyone's mean wind within 0.5 m/s of the mean flown through."""
+    flown speeds; pitotcal's drifting wind (chosen by its test) and AirspeedFit's smoothed
+    track within 1 m/s rms of the true track (a constant wind is ~2 m/s off it); everyone's
+    mean wind within 0.5 m/s of the mean flown through."""
     data, _ = run
     s = data["summary"]["drifting"]
     assert s["pitotcal constant"]["dv_err_max_kt_median"] < 0.6
-    assert 1.5 < s["pitotcal constant"]["wind_track_rms_mps_median"] < 3.0
+    assert s["pitotcal constant"]["wind_track_rms_mps_median"] < 1.0
     for name in s:
         assert s[name]["wind_mean_err_mps_median"] < 0.5, name
     if data["skipped"] is None:

@@ -207,8 +207,9 @@ def _resolved_budget(flight, result, inputs, identify_kwargs, solved, method):
     rows = result.correction_table()
     vi = np.array([r["vi_kt"] for r in rows])
     stat = np.array([r["dv_2sigma_kt"] for r in rows]) / 2.0
+    # the re-solves hold a drifting wind's drift at its fit (`flight` has it taken out)
     kwargs = {**identify_kwargs, "gps_noise_std_mps": result.gps_noise_std_mps,
-              "model": result.model}
+              "model": result.model, "wind": "constant"}
     notes = []
     dv0 = np.asarray(result.delta_v_kt(vi)[0], dtype=float)
     linear = _linearised(flight, result, notes) if method == "sensitivity" else None

@@ -21,6 +21,7 @@ from ..robustness import consistency, gates
 from . import static_source
 from .oe import OutputErrorProblem
 from .unknowns import WIND_INTERNAL
+from .wind_drift import check_wind_options, fit_wind
 
 __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG", "estimate",
            "fit", "track_spread_deg"]
@@ -39,15 +40,17 @@ _TRIM_ROUNDS = 3
 
 
 def fit(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
-        ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
+        ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, wind="auto",
+        wind_knot_s=None):
     """The fit with its bounds (colored-residual covariance, consistency checks): `identify`
     without the result record's products (noise model, static-error fit, budget)."""
     return _identify(flight, model, air, gps_noise_std_mps, ipopt_options,
-                     (gps_error_sigma_mps, gps_error_tau_s), bounds=True)
+                     (gps_error_sigma_mps, gps_error_tau_s), (wind, wind_knot_s), bounds=True)
 
 
 def estimate(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
-             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None):
+             ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, wind="auto",
+             wind_knot_s=None):
     """`identify`'s estimate alone, for re-solves that use only it (`estimation.identification.budget`).
 
     The same checks, gates, outlier trimming and fit, so the same parameters; without the
@@ -55,12 +58,14 @@ def estimate(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     `consistency` is empty, so its bounds are not the result's.
     """
     return _identify(flight, model, air, gps_noise_std_mps, ipopt_options,
-                     (gps_error_sigma_mps, gps_error_tau_s), bounds=False)
+                     (gps_error_sigma_mps, gps_error_tau_s), (wind, wind_knot_s), bounds=False)
 
 
-def _identify(flight, model, air, gps_noise_std_mps, ipopt_options, gps_error, *, bounds):
-    """`identify` (`bounds` True) or `estimate` (False)."""
+def _identify(flight, model, air, gps_noise_std_mps, ipopt_options, gps_error, wind, *,
+              bounds):
+    """`identify` (`bounds` True) or `estimate` (False); `wind` is (mode, knot spacing s)."""
     checks.choice("model", model, (*MODELS, "auto"))
+    wind, knot_s = check_wind_options(*wind)
     if gps_noise_std_mps is not None:
         gps_noise_std_mps = checks.number("gps_noise_std_mps", gps_noise_std_mps, 0.0,
                                           GPS_NOISE_MAX_MPS)
@@ -72,10 +77,13 @@ def _identify(flight, model, air, gps_noise_std_mps, ipopt_options, gps_error, *
     flight, gate_note = gates.gate_flight(flight)
     _check_flight(flight, air_data)
     _check_track(flight)
-    result, trim_note = _fit_trimmed(flight, functools.partial(
+    fitter = functools.partial(
         _identify_any, model=model, gps_noise_std_mps=gps_noise_std_mps,
-        ipopt_options=ipopt_options, air_data=air_data, gps_error=gps_error, colored=bounds),
-        air_data, check=bounds)
+        ipopt_options=ipopt_options, air_data=air_data, gps_error=gps_error, colored=bounds)
+    result, trim_note = fit_wind(
+        flight, functools.partial(_fit_trimmed, fit=fitter, air_data=air_data, check=bounds),
+        wind=wind, knot_s=knot_s, gps_noise_std_mps=gps_noise_std_mps, air_data=air_data,
+        gps_error=gps_error)
     # the reader's warnings first, so the record (to_dict, the JSON) carries every warning
     warn = tuple(dict.fromkeys(tuple(flight.warnings) + gate_note + trim_note
                                + tuple(result.warnings) + air_note))

@@ -29,6 +29,7 @@ from .fit import (
     track_spread_deg,
 )
 from .view import correction_table
+from .wind_drift import without_drift
 
 __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_DEG",
            "TEMPERATURE_TOL_K", "budget_inputs", "complete", "estimate", "identify", "track_spread_deg"]
@@ -36,7 +37,7 @@ __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_D
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None,
-             probe_arm_m=0.0):
+             probe_arm_m=0.0, wind="auto", wind_knot_s=None):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -51,11 +52,10 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
         temperature `oat_k`, with all the pressure error in the static source (the default,
         `DEFAULT_AIR_DATA`, which `simulate` flies), or the paper's eq. 2, q_c = ½ρV_t²
-        ("incompressible"). A
-        flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
-        an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
-        it instead, and the static and total pressure errors are separated
-        (`estimation.identification.static_source`).
+        ("incompressible"). A flight without `ps_pa` and `oat_k` is fitted incompressible
+        with a warning. With an independent reference static pressure `ps_ref_pa` as well,
+        q_c is predicted from it instead, and the static and total pressure errors are
+        separated (`estimation.identification.static_source`).
     gps_noise_std_mps : float, optional
         GPS velocity noise per component, m/s, for the errors-in-variables correction;
         estimated from the data when None.
@@ -71,6 +71,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     probe_arm_m : float
         Lateral position of the pitot probe, m (right wing +), corrected in the data
         (`_fit_corrected`); the record's `reading` keeps it. Default 0.
+    wind, wind_knot_s : {"auto", "constant", "drifting"}, float or None
+        The wind model and a drift's knot spacing, s (`wind_drift.fit_wind`; None: 300 s).
 
     Returns
     -------
@@ -81,7 +83,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         and the result record's products, each computed once here: `monitor_noise` (the
         residuals' noise model `pitotcal monitor` designs from), `static_fit` (the measured
         static-error fit, with a reference static pressure), `budget`, `gps_error` (the
-        statement), `reading` (how `read_flight` read the flight), `source`, `n_dropped`.
+        statement), `reading`, `source`, `n_dropped`, `wind_model` and `wind_track`.
         `to_dict()` is the record `pitotcal identify --json` writes.
 
     Raises
@@ -97,8 +99,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
 
     Notes
     -----
-    A solver that does not converge is not an exception: `success` is False, `message` is
-    IPOPT's status and `warnings` says so.
+    Non-convergence is a result, not an exception: `success` False, IPOPT's status in `message`.
 
     "auto" uses the Bayesian information criterion with an effective sample size (see
     `_identify_auto`).
@@ -112,7 +113,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     inputs = budget_inputs(budget)
     arm_m = checks.number("probe_arm_m", probe_arm_m, -50.0, 50.0)
     options = {"air": air, "gps_noise_std_mps": gps_noise_std_mps, "ipopt_options": ipopt_options,
-               "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s}
+               "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s,
+               "wind": wind, "wind_knot_s": wind_knot_s}
     flight, result = _fit_corrected(flight, model, arm_m, options)
     refit = functools.partial(fit, model=model, **options)
     result, flight = _at_calibrated_mach(result, flight, refit)
@@ -200,6 +202,8 @@ def complete(result, flight, *, air, budget=None, gps_error=(None, None)):
     result = _with_warning(result, _incompressible_note(result, flight))
     if budget is None:
         return result
+    if result.drift is not None:        # the budget perturbs the flight the fit solved
+        flight = without_drift(flight, *result.drift)
     try:
         return dataclasses.replace(
             result, budget=uncertainty_budget(flight, result, budget, air=air))

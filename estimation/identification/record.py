@@ -31,7 +31,8 @@ def to_dict(result):
         criterion, timing_s, air_data, consistency (when it ran), static_source (compressible),
         source, n_dropped, uncertainty_budget (with a budget), noise_model (absent for a record
         too short for it), gps_error, reading; windows and cut_s when the windows were
-        chosen from a whole-flight log (`pitotcal.io.windows`).
+        chosen from a whole-flight log (`pitotcal.io.windows`); wind_model and wind_track
+        (when fitted).
     """
     from .view import correction_table
 
@@ -75,6 +76,8 @@ def to_dict(result):
     if reading and reading.get("windows"):      # the windows chosen from a whole-flight log
         out.update(windows=reading.pop("windows"), cut_s=reading.pop("cut_s", {}))
     out.update(gps_error=result.gps_error, reading=reading)
+    if result.wind_model is not None:       # docs/interfaces.md §3, the wind model
+        out.update(wind_model=result.wind_model, wind_track=result.wind_track)
     return json_ready(out)
 
 

@@ -81,6 +81,15 @@ class IdentificationResult:
         The flight's source (file or stream).
     n_dropped : int
         Rows (or log samples) the reader dropped.
+    wind_model : dict or None
+        How the wind was modelled (`estimation.identification.wind_drift`): {kind ("constant"
+        or "drifting"), knot_s, test (the Wald test of no drift, or None), chosen_by}.
+    wind_track : dict or None
+        The wind along the record: {time_s, speed_mps, from_deg, speed_2sigma_mps,
+        from_2sigma_deg[, segment]} (two points for a constant wind).
+    drift : (DriftBasis, ndarray) or None
+        The fitted drift of a drifting wind (`wind_drift.without_drift` takes it out of a
+        flight's GPS velocity); None for a constant wind.
     """
 
     model: str
@@ -116,6 +125,9 @@ class IdentificationResult:
     budget: object = None
     source: str = "<memory>"
     n_dropped: int = 0
+    wind_model: dict | None = None
+    wind_track: dict | None = None
+    drift: tuple | None = None
 
     # --- derived quantities -------------------------------------------------------------
     @property

@@ -154,6 +154,7 @@ def summary(result):
          f"{'(±' + _fmt(spd2p, 2) + ')':>14}   = {_fmt(result.value('wind_speed_mps'), 4)} m/s"),
         (f"  {'wind from':<14}{f'{frm:.1f}°':>12}{'±' + _fmt(frm2, 2) + '°':>12}"
          f"{'(±' + _fmt(frm2p, 2) + '°)':>14}   true, the direction it blows from"),
+        *_wind_model_lines(result),
         "",
     ]
     table = correction_table(result)
@@ -203,12 +204,35 @@ def _every(n, limit):
     return np.arange(0, n, max(1, n // limit))
 
 
+def _wind_model_lines(result):
+    """A drifting wind's line of the summary: the drift, the knots and the test (none for a
+    constant wind: the mean wind above is the whole wind)."""
+    wm = result.wind_model or {}
+    if wm.get("kind") == "constant per window":
+        track = result.wind_track
+        return ["  wind per calibration window: " + "; ".join(
+            f"{i + 1}: {mps_to_kt(v):.1f} ± {mps_to_kt(u):.1f} kt from {f:.0f}°"
+            for i, (v, u, f) in enumerate(zip(track["speed_mps"], track["speed_2sigma_mps"],
+                                              track["from_deg"])))]
+    if wm.get("kind") != "drifting":
+        return []
+    from .wind_drift import drift_size
+
+    vec, dspeed, turn = drift_size(result.wind_track)
+    test = wm.get("test") or {}
+    stat = (f"; Wald test of no drift {test['statistic']:.1f} on {test['dof']} dof"
+            if test else "")
+    return [f"  wind drifting (time-average above): moved {vec:.1f} m/s (speed "
+            f"{dspeed:.1f} m/s, direction {turn:.0f}°), knots every {wm['knot_s']:.0f} s{stat}"]
+
+
 def plot(result, path=None):
     """The calibration figure in the manner of the paper's Figs. 7-8.
 
     Four panels: ΔV vs V_i with the 2-sigma band (plain Hessian band dashed); Δp/q_c vs q_ci
     with its band and the per-sample ratio implied by the residuals as faint points; the
-    q_ci distribution; the residual time history. The wind is in the title. A compressible
+    q_ci distribution; the residual time history. The wind is in the title; a drifting wind
+    adds its track with the 2-sigma bands of speed and direction below. A compressible
     result shows Δp_p/q_cic vs M_ic and ΔH_pc vs V_ic (`estimation.identification.static_source`) in place
     of the second and third.
 
@@ -224,8 +248,12 @@ def plot(result, path=None):
     """
     from matplotlib.figure import Figure  # no pyplot: no GUI backend, safe in workers
 
-    fig = Figure(figsize=(12, 8.5), layout="constrained")
-    ax_dv, ax_dp, ax_hist, ax_res = fig.subplots(2, 2).ravel()
+    drifting = (result.wind_model or {}).get("kind") == "drifting"
+    fig = Figure(figsize=(12, 11.5 if drifting else 8.5), layout="constrained")
+    grid = fig.add_gridspec(3 if drifting else 2, 2)
+    ax_dv, ax_dp, ax_hist, ax_res = (fig.add_subplot(grid[i, j]) for i in (0, 1) for j in (0, 1))
+    if drifting:
+        _plot_wind_track(fig.add_subplot(grid[2, :]), result.wind_track)
     _plot_correction(ax_dv, result)
     if _compressible(result) and result.ps_pa is not None:
         # the static-source products in place of Δp/q_c vs q_ci and the q_ci histogram
@@ -239,7 +267,8 @@ def plot(result, path=None):
     spd, spd2, _, frm, frm2, _ = _wind(result)
     state = "" if result.converged else "   [SOLVER DID NOT CONVERGE]"
     air = " (compressible, V_i = V_ic)" if _compressible(result) else ""
-    fig.suptitle(f"{result.model} model{air}, {result.n_samples} samples — wind {spd:.1f} ± {spd2:.1f}"
+    wind = "time-average wind" if drifting else "wind"
+    fig.suptitle(f"{result.model} model{air}, {result.n_samples} samples — {wind} {spd:.1f} ± {spd2:.1f}"
                  f" kt from {frm:.0f}° ± {frm2:.1f}° (2σ){state}", fontsize=13)
     if path is not None:
         from pitotcal.io.atomic import save_figure
@@ -304,6 +333,26 @@ def _plot_distribution(ax, result):
         "top", functions=(lambda q: mps_to_kt(incompressible_cas_mps(q)),
                           lambda v: 0.5 * RHO0_KGM3 * (np.asarray(v) / mps_to_kt(1.0)) ** 2))
     ax_v.set_xlabel("V_i (kt)")
+
+
+def _plot_wind_track(ax, track):
+    """The fitted wind's speed (kt, left) and direction from (deg, right) along the record,
+    each with its 2-sigma band."""
+    t = np.asarray(track["time_s"], dtype=float)
+    speed = mps_to_kt(np.asarray(track["speed_mps"], dtype=float))
+    s2 = mps_to_kt(np.asarray(track["speed_2sigma_mps"], dtype=float))
+    ax.fill_between(t, speed - s2, speed + s2, color="tab:blue", alpha=0.25)
+    ax.plot(t, speed, color="tab:blue", lw=2, label="wind speed (2σ band)")
+    ax.set(xlabel="time (s)", ylabel="wind speed (kt)", title="Drifting wind")
+    ax_dir = ax.twinx()
+    direction = np.degrees(np.unwrap(np.radians(track["from_deg"])))
+    f2 = np.asarray(track["from_2sigma_deg"], dtype=float)
+    ax_dir.fill_between(t, direction - f2, direction + f2, color="tab:orange", alpha=0.2)
+    ax_dir.plot(t, direction, color="tab:orange", lw=2, label="from (2σ band)")
+    ax_dir.set_ylabel("wind from (deg true)")
+    lines = ax.get_legend_handles_labels()
+    more = ax_dir.get_legend_handles_labels()
+    ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="best")
 
 
 def _plot_residuals(ax, result):

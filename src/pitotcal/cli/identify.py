@@ -69,6 +69,13 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
+    p.add_argument("--wind", default="auto", metavar="MODEL",
+                   help="wind model: constant, drifting (a wind varying slowly in time, "
+                        "piecewise linear between knots) or auto: drifting when a Wald test "
+                        "of no drift rejects it at 1%% (default: auto)")
+    p.add_argument("--wind-knot-s", type=float, default=None, metavar="S",
+                   help="knot spacing of the drifting wind, s (default: 300 s, or two of the "
+                        "flight's orbits when it turns more slowly)")
     _add_params_and_live(p)
     add_budget_arguments(p, _help_constants)
     # --- the GPS receiver's time-correlated velocity error, stated ---
@@ -250,11 +257,13 @@ def _identify_all(args, source, sensors, inputs):
     flight, autopilot, current = _read(args, source)
     arm_m = sensors[0].get("probe_arm_m", 0.0)
     flights = [flight, *other_sensor_flights(source, flight, csv_columns=args.columns, single_only={
-        "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m})]
+        "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m,
+        "--wind drifting": args.wind == "drifting", "--wind-knot-s": args.wind_knot_s})]
     fit = (identify_sensors(flights, model=args.model, air=args.air, budget=inputs,
                             gps_noise_std_mps=args.gps_noise_mps) if len(flights) > 1 else
            [identify(flight, model=args.model, air=args.air, budget=inputs, probe_arm_m=arm_m,
-                     gps_noise_std_mps=args.gps_noise_mps, **_gps_error(args))])
+                     gps_noise_std_mps=args.gps_noise_mps, wind=args.wind,
+                     wind_knot_s=args.wind_knot_s, **_gps_error(args))])
     return flight, autopilot, current, flights, fit
 
 

@@ -92,7 +92,9 @@ def test_altimeter_correction_is_what_the_static_port_shows(flown):
 def test_incompressible_fit_shows_the_bias(flown):
     name, flight, truth, result = flown
     vi = _vi_grid(result)
-    incompressible = identify(flight, model="inverse", air="incompressible")
+    # the formula's bias under a constant wind: with the speed swept once in time, a drifting
+    # wind ("auto" chooses it on this misfit) takes up a part of it (-1.91, -6.52 kt here)
+    incompressible = identify(flight, model="inverse", air="incompressible", wind="constant")
     assert incompressible.air_data == "incompressible"
     dv, band = incompressible.delta_v_kt(vi)
     miss = dv - delta_v_kt(get_model(truth.model), truth.k, vi, "compressible")
