@@ -13,9 +13,11 @@ from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA, INCOMPRESSIBLE_MACH_MAX, flight_mach
 from pitotcal.core.moist_air import at_mach
+from pitotcal.core.scenario import HIDES_THRESHOLD_KT
 from pitotcal.core.units import wind_vector_mps
 from pitotcal.io.result_record import check_noise_model
 
+from ..robustness.consistency import with_hides_threshold
 from ..uncertainty.block_noise import block_residual_stats
 from . import static_source
 from .budget import BudgetInputs, lever_arm_corrected, uncertainty_budget
@@ -36,7 +38,7 @@ __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_D
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None,
-             probe_arm_m=0.0):
+             probe_arm_m=0.0, hides_threshold_kt=HIDES_THRESHOLD_KT):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -51,11 +53,10 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
         temperature `oat_k`, with all the pressure error in the static source (the default,
         `DEFAULT_AIR_DATA`, which `simulate` flies), or the paper's eq. 2, q_c = ½ρV_t²
-        ("incompressible"). A
-        flight without `ps_pa` and `oat_k` is fitted incompressible with a warning. With
-        an independent reference static pressure `ps_ref_pa` as well, q_c is predicted from
-        it instead, and the static and total pressure errors are separated
-        (`estimation.identification.static_source`).
+        ("incompressible"). A flight without `ps_pa` and `oat_k` is fitted incompressible
+        with a warning. With an independent reference static pressure `ps_ref_pa` as well,
+        q_c is predicted from it instead, and the static and total pressure errors are
+        separated (`estimation.identification.static_source`).
     gps_noise_std_mps : float, optional
         GPS velocity noise per component, m/s, for the errors-in-variables correction;
         estimated from the data when None.
@@ -71,6 +72,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     probe_arm_m : float
         Lateral position of the pitot probe, m (right wing +), corrected in the data
         (`_fit_corrected`); the record's `reading` keeps it. Default 0.
+    hides_threshold_kt : float
+        ΔV shift, kt, of a missed leak above which the maneuver is said to hide one (`hides`).
 
     Returns
     -------
@@ -109,15 +112,15 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
-    inputs = budget_inputs(budget)
+    inputs, kt = budget_inputs(budget), checks.positive("hides_threshold_kt", hides_threshold_kt)
     arm_m = checks.number("probe_arm_m", probe_arm_m, -50.0, 50.0)
     options = {"air": air, "gps_noise_std_mps": gps_noise_std_mps, "ipopt_options": ipopt_options,
                "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s}
     flight, result = _fit_corrected(flight, model, arm_m, options)
     refit = functools.partial(fit, model=model, **options)
     result, flight = _at_calibrated_mach(result, flight, refit)
-    return complete(result, flight, air=air, budget=inputs,
-                    gps_error=(gps_error_sigma_mps, gps_error_tau_s))
+    return with_hides_threshold(complete(result, flight, air=air, budget=inputs, gps_error=(
+        gps_error_sigma_mps, gps_error_tau_s)), kt)
 
 
 # The total-to-static temperature conversion is iterated until T_s moves less than this, K

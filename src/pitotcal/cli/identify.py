@@ -9,7 +9,7 @@ after the summary; the JSON and figure are written first).
 
 from pathlib import Path
 
-from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
+from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA, HIDES_THRESHOLD_KT
 
 MODEL_CHOICES = ("inverse", "constant", "linear", "auto")
 # the default first, as --help and the error list them
@@ -89,6 +89,10 @@ def add_parser(subparsers):
                           "looks like wind); with --gps-error-tau-s; default: none stated")
     gps.add_argument("--gps-error-tau-s", type=float, default=None, metavar="S",
                      help="its correlation time, s (e.g. 30); with --gps-error-sigma-mps")
+    p.add_argument("--hides-threshold-kt", type=float, default=HIDES_THRESHOLD_KT, metavar="KT",
+                   help="say that the maneuver hides a change of scale (a leak) only when one "
+                        "the consistency checks would miss moves dV by more than KT "
+                        "(default %(default)s)")
     p.set_defaults(run=run)
 
 
@@ -247,6 +251,7 @@ def run(args):
     # the live options are checked with a file too: a NaN is no option anywhere
     idle_timeout_s(args.idle_s)
     positive("target_2sigma_kt", args.target_2sigma_kt)
+    positive("hides_threshold_kt", args.hides_threshold_kt)
     if args.misfit_tolerance_kt is not None:
         from pitotcal.estimation.reporting.autopilot_params import check_misfit_tolerance
 
@@ -272,7 +277,8 @@ def run(args):
     flight, autopilot, current = _read(args, source)
     result = identify(flight, model=args.model, air=args.air,
                       gps_noise_std_mps=args.gps_noise_mps, budget=inputs,
-                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0), **_gps_error(args))
+                      probe_arm_m=sensors[0].get("probe_arm_m", 0.0),
+                      hides_threshold_kt=args.hides_threshold_kt, **_gps_error(args))
     budget = result.budget
 
     # every file is written before anything is printed, so a reader that goes away early
