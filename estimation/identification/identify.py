@@ -17,7 +17,7 @@ from pitotcal.core.scenario import HIDES_THRESHOLD_KT
 from pitotcal.core.units import wind_vector_mps
 from pitotcal.io.result_record import check_noise_model
 
-from ..robustness.consistency import with_hides_threshold
+from ..robustness.consistency import hides_threshold, with_hides_threshold
 from ..uncertainty.block_noise import block_residual_stats
 from . import static_source
 from .budget import BudgetInputs, lever_arm_corrected, uncertainty_budget
@@ -112,7 +112,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
-    inputs, kt = budget_inputs(budget), checks.positive("hides_threshold_kt", hides_threshold_kt)
+    inputs, kt = budget_inputs(budget), hides_threshold(hides_threshold_kt)
     arm_m = checks.number("probe_arm_m", probe_arm_m, -50.0, 50.0)
     options = {"air": air, "gps_noise_std_mps": gps_noise_std_mps, "ipopt_options": ipopt_options,
                "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s}

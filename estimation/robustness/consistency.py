@@ -36,10 +36,11 @@ from pitotcal.core.scenario import HIDES_THRESHOLD_KT
 from ..uncertainty.covariance import colored_covariance
 from ..uncertainty.residual_noise import block_means
 
-__all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "HIDES", "HIDES_THRESHOLD_KT", "KINDS",
-           "MARGIN", "MIN_SHIFT_KT", "ONSETS", "POWER", "TAIL_SIGMAS", "TAIL_WINDOW_S", "check",
-           "collapse_onset_s", "hidden_bound", "hidden_warning", "hides", "step_test",
-           "tail_warning", "with_hides_threshold"]
+__all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "HIDES", "HIDES_THRESHOLD_KT",
+           "HIDES_THRESHOLD_MAX_KT", "KINDS", "MARGIN", "MIN_SHIFT_KT", "ONSETS", "POWER",
+           "TAIL_SIGMAS", "TAIL_WINDOW_S", "check", "collapse_onset_s", "hidden_bound",
+           "hidden_warning", "hides", "hides_threshold", "step_test", "tail_warning",
+           "with_hides_threshold"]
 
 # Onsets scanned, as fractions of the record, every 3 % (finer costs threshold: the Bonferroni
 # bound grows with the number of alternatives): from a fifth of the record, as a change before
@@ -94,6 +95,8 @@ TAIL_MIN_FALL = 0.02
 # A hidden step (`HIDDEN_RATIO`) also moves ΔV by more than this, kt: below it no airspeed
 # indicator shows it.
 MIN_SHIFT_KT = 0.1
+# The largest `hides_threshold_kt` taken, kt.
+HIDES_THRESHOLD_MAX_KT = 100.0
 # The words that mark the statement among a result's warnings.
 HIDES = "hides in the calibration"
 # The noise model of the step's variance: the identification's own (several time scales).
@@ -258,11 +261,17 @@ def hides(details, threshold_kt=HIDES_THRESHOLD_KT):
     `MIN_SHIFT_KT`: its geometry), and a sudden change (a leak) that neither the scan nor the
     abrupt-jump test catches moves ΔV by more than `threshold_kt` (what matters to the user).
     """
-    kt = checks.positive("hides_threshold_kt", threshold_kt)
+    kt = hides_threshold(threshold_kt)
     step, sudden = details["undetected"], details.get("undetected_sudden") \
         or details["undetected"]
     geometry = step["dv_shift_kt"] > max(HIDDEN_RATIO * step["dv_2sigma_kt"], MIN_SHIFT_KT)
     return {"hidden": bool(geometry and sudden["dv_shift_kt"] > kt), "hides_threshold_kt": kt}
+
+
+def hides_threshold(value):
+    """`hides_threshold_kt` checked: a ΔV shift in kt, > 0 and at most `HIDES_THRESHOLD_MAX_KT`
+    (beyond any airspeed error a calibration is flown for: say "never" with it)."""
+    return checks.number("hides_threshold_kt", value, 0.0, HIDES_THRESHOLD_MAX_KT, lo_open=True)
 
 
 def _jump_steps(qci, first, detectable_pa):
@@ -387,7 +396,7 @@ def with_hides_threshold(result, threshold_kt):
 
     found = result.consistency
     if not found or "undetected" not in found:
-        checks.positive("hides_threshold_kt", threshold_kt)
+        hides_threshold(threshold_kt)
         return result
     found = {**found, **hides(found, threshold_kt)}
     jumped = bool((found.get("jump") or {}).get("flagged"))

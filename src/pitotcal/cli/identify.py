@@ -251,7 +251,9 @@ def run(args):
     # the live options are checked with a file too: a NaN is no option anywhere
     idle_timeout_s(args.idle_s)
     positive("target_2sigma_kt", args.target_2sigma_kt)
-    positive("hides_threshold_kt", args.hides_threshold_kt)
+    from pitotcal.estimation.robustness.consistency import hides_threshold
+
+    hides_threshold(args.hides_threshold_kt)
     if args.misfit_tolerance_kt is not None:
         from pitotcal.estimation.reporting.autopilot_params import check_misfit_tolerance
 
