@@ -241,10 +241,9 @@ def step_test(flight, result, air_data, *, detectable_jump_pa=None,
     # (`hidden_bound`), as the margin is for the noise model's tails
     n_mid = int(np.sum(ONSETS <= HIDDEN_LAST_ONSET + 1e-9))
     z_detect = hidden_bound(n_mid) + float(normal_isf(1 - POWER))
-    hidden = _undetected(result, model, onsets[:n_mid], scan, z_detect)
-    sudden = _undetected(result, model, onsets[:n_mid], scan, z_detect,
-                         _jump_steps(np.asarray(ch.qci, float), first[1:n_mid + 1],
-                                     detectable_jump_pa))
+    hidden, sudden = _undetected(result, model, onsets[:n_mid], scan, z_detect,
+                                 _jump_steps(np.asarray(ch.qci, float), first[1:n_mid + 1],
+                                             detectable_jump_pa))
     details.update(undetected=hidden, undetected_sudden=sudden)
     details.update(hides(details, hides_threshold_kt))
     if details["flagged"]:
@@ -557,7 +556,8 @@ def _undetected(result, model, onsets, scan, z_detect, sudden=None):
     error counted is the smaller of the two, so a step near either end of the record, which
     leaves one calibration for most of it, is not counted as hidden. `sudden` (one fraction
     per onset, `_jump_steps`): the abrupt-jump test's smallest caught change, which caps the
-    scan's where smaller.
+    scan's where smaller; the second of the two results returned is for that change (the
+    first again when `sudden` is None).
     """
     from pitotcal.core.propagation import band as sigma_of
     from pitotcal.core.propagation import gradient
@@ -575,11 +575,9 @@ def _undetected(result, model, onsets, scan, z_detect, sudden=None):
     dv_fit = delta_v_kt(model, k, vi, result.air_data)
     grad = gradient(lambda kk: delta_v_kt(model, kk, vi, result.air_data), k)
     band = np.maximum(2.0 * sigma_of(grad, cov_k), 1e-12)
-    best = None
-    for i, onset in enumerate(onsets):
-        size = z_detect * scan["plain"][i] * np.sqrt(inflation)
-        if sudden is not None:
-            size = min(size, float(sudden[i]))
+
+    def at(i, size):
+        """(ratio, numbers) of a step of `size` from onset i."""
         off = [scan["shift"][i, :nk] * size,                                   # from before
                (scan["shift"][i, :nk] - scan["shift_all"][:nk]) * size]        # from after
         shifts = [_dv_shift_kt(model, k - dk, vi, dv_fit, dk @ grad, result.air_data)
@@ -587,15 +585,23 @@ def _undetected(result, model, onsets, scan, z_detect, sudden=None):
         pick = int(np.argmin([np.max(d / band) for d, _ in shifts]))
         dk, (dv, linear) = off[pick], shifts[pick]
         j = int(np.argmax(dv / band))
-        if best is None or dv[j] / band[j] > best[0]:
-            k_sigma = float(np.sqrt(max(dk @ np.linalg.solve(cov_k, dk), 0.0)))
-            best = (dv[j] / band[j], {
-                "onset_s": float(onset), "step": float(size), "power": POWER,
-                "dv_shift_kt": float(dv[j]), "dv_2sigma_kt": float(band[j]),
-                "vi_kt": float(vi[j]), "k_shift_sigma": k_sigma,
-                # the band printed in the result's table at that speed (the warning's ratio)
-                "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"]),
-                # speeds where the shifted calibration has no V_c (beyond the Mach
-                # range of the pitot relations): its shift there is the first-order one
-                "first_order_vi_kt": [float(v) for v in vi[linear]]})
-    return best[1]
+        return dv[j] / band[j], {
+            "onset_s": float(onsets[i]), "step": float(size), "power": POWER,
+            "dv_shift_kt": float(dv[j]), "dv_2sigma_kt": float(band[j]),
+            "vi_kt": float(vi[j]),
+            "k_shift_sigma": float(np.sqrt(max(dk @ np.linalg.solve(cov_k, dk), 0.0))),
+            # the band printed in the result's table at that speed (the warning's ratio)
+            "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"]),
+            # speeds where the shifted calibration has no V_c (beyond the Mach range of
+            # the pitot relations): its shift there is the first-order one
+            "first_order_vi_kt": [float(v) for v in vi[linear]]}
+
+    best = [None, None]
+    for i in range(len(onsets)):
+        size = z_detect * scan["plain"][i] * np.sqrt(inflation)
+        step = at(i, size)
+        quick = step if sudden is None or sudden[i] >= size else at(i, float(sudden[i]))
+        for n, got in enumerate((step, quick)):
+            if best[n] is None or got[0] > best[n][0]:
+                best[n] = got
+    return best[0][1], best[1][1]
