@@ -13,9 +13,11 @@ from pitotcal.core import checks
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.measurement import DEFAULT_AIR_DATA, INCOMPRESSIBLE_MACH_MAX, flight_mach
 from pitotcal.core.moist_air import at_mach
+from pitotcal.core.scenario import HIDES_THRESHOLD_KT
 from pitotcal.core.units import wind_vector_mps
 from pitotcal.io.result_record import check_noise_model
 
+from ..robustness.consistency import hides_threshold, with_hides_threshold
 from ..uncertainty.block_noise import block_residual_stats
 from . import static_source
 from .budget import BudgetInputs, lever_arm_corrected, uncertainty_budget
@@ -37,7 +39,8 @@ __all__ = ["MAX_CORRELATION", "MIN_QCI_SPAN", "MIN_SAMPLES", "MIN_TRACK_SPREAD_D
 
 def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps=None,
              ipopt_options=None, gps_error_sigma_mps=None, gps_error_tau_s=None, budget=None,
-             probe_arm_m=0.0, wind="auto", wind_knot_s=None):
+             probe_arm_m=0.0, wind="auto", wind_knot_s=None,
+             hides_threshold_kt=HIDES_THRESHOLD_KT):
     """Identify the pressure-error model and the wind from one calibration flight.
 
     Parameters
@@ -45,8 +48,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     flight : pitotcal.core.flight.Flight
         Time, measured impact pressure q_ci, GPS ground velocity, density (SI).
     model : {"inverse", "constant", "linear", "auto"}
-        Pressure-error structure (docs/interfaces.md §2); "auto" fits every structure in
-        `pitotcal.core.models.MODELS` and keeps the one with the lowest BIC.
+        Pressure-error structure (docs/interfaces.md §2); "auto": the lowest BIC of `MODELS`.
     air : {"compressible", "incompressible"}
         How the impact pressure follows from the true airspeed (`pitotcal.core.measurement`):
         isentropic from the flight's static pressure `ps_pa` (the static port's reading) and
@@ -62,7 +64,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     ipopt_options : dict, optional
         IPOPT options (without the ``ipopt.`` prefix), e.g. ``{"max_iter": 50}``.
     gps_error_sigma_mps, gps_error_tau_s : float, optional
-        The GPS receiver's Gauss-Markov velocity error (m/s, s; both or neither): known noise.
+        The GPS receiver's Gauss-Markov velocity error (m/s, s; both or neither).
     budget : BudgetInputs or True, optional
         Compute the GUM uncertainty budget of the airspeed correction
         (`estimation.identification.budget`) with these Type B inputs (True: the defaults);
@@ -73,6 +75,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
         (`_fit_corrected`); the record's `reading` keeps it. Default 0.
     wind, wind_knot_s : {"auto", "constant", "drifting"}, float or None
         The wind model and a drift's knot spacing, s (`wind_drift.fit_wind`; None: 300 s).
+    hides_threshold_kt : float
+        ΔV shift, kt, of a missed leak above which the maneuver is said to hide one (`hides`).
 
     Returns
     -------
@@ -100,9 +104,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     Notes
     -----
     Non-convergence is a result, not an exception: `success` False, IPOPT's status in `message`.
-
-    "auto" uses the Bayesian information criterion with an effective sample size (see
-    `_identify_auto`).
+    "auto" uses the BIC with an effective sample size (`_identify_auto`).
 
     Example
     -------
@@ -110,7 +112,7 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     >>> identify(synthetic_flight(seed=1)[0]).value("k2")    # doctest: +SKIP
     -15.0...
     """
-    inputs = budget_inputs(budget)
+    inputs, kt = budget_inputs(budget), hides_threshold(hides_threshold_kt)
     arm_m = checks.number("probe_arm_m", probe_arm_m, -50.0, 50.0)
     options = {"air": air, "gps_noise_std_mps": gps_noise_std_mps, "ipopt_options": ipopt_options,
                "gps_error_sigma_mps": gps_error_sigma_mps, "gps_error_tau_s": gps_error_tau_s,
@@ -118,8 +120,8 @@ def identify(flight, model="inverse", *, air=DEFAULT_AIR_DATA, gps_noise_std_mps
     flight, result = _fit_corrected(flight, model, arm_m, options)
     refit = functools.partial(fit, model=model, **options)
     result, flight = _at_calibrated_mach(result, flight, refit)
-    return complete(result, flight, air=air, budget=inputs,
-                    gps_error=(gps_error_sigma_mps, gps_error_tau_s))
+    return with_hides_threshold(complete(result, flight, air=air, budget=inputs, gps_error=(
+        gps_error_sigma_mps, gps_error_tau_s)), kt)
 
 
 # The total-to-static temperature conversion is iterated until T_s moves less than this, K

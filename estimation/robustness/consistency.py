@@ -27,16 +27,20 @@ dependence), and the result says so.
 
 import numpy as np
 
+from pitotcal.core import checks
 from pitotcal.core.information import normal_isf
 from pitotcal.core.measurement import flight_channels, sensitivities
 from pitotcal.core.models import delta_v_kt, delta_v_kt_where_defined, get_model
+from pitotcal.core.scenario import HIDES_THRESHOLD_KT
 
 from ..uncertainty.covariance import colored_covariance
 from ..uncertainty.residual_noise import block_means
 
-__all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "KINDS", "MARGIN", "MIN_SHIFT_KT", "ONSETS", "POWER", "check",
-           "TAIL_SIGMAS", "TAIL_WINDOW_S", "collapse_onset_s", "hidden_bound", "hidden_warning",
-           "step_test", "tail_warning"]
+__all__ = ["ALPHA", "COLLAPSE_FRACTION", "HIDDEN_RATIO", "HIDES", "HIDES_THRESHOLD_KT",
+           "HIDES_THRESHOLD_MAX_KT", "KINDS", "MARGIN", "MIN_SHIFT_KT", "ONSETS", "POWER",
+           "TAIL_SIGMAS", "TAIL_WINDOW_S", "check", "collapse_onset_s", "hidden_bound",
+           "hidden_warning", "hides", "hides_threshold", "step_test", "tail_warning",
+           "with_hides_threshold"]
 
 # Onsets scanned, as fractions of the record, every 3 % (finer costs threshold: the Bonferroni
 # bound grows with the number of alternatives): from a fifth of the record, as a change before
@@ -91,6 +95,10 @@ TAIL_MIN_FALL = 0.02
 # A hidden step (`HIDDEN_RATIO`) also moves ΔV by more than this, kt: below it no airspeed
 # indicator shows it.
 MIN_SHIFT_KT = 0.1
+# The largest `hides_threshold_kt` taken, kt.
+HIDES_THRESHOLD_MAX_KT = 100.0
+# The words that mark the statement among a result's warnings.
+HIDES = "hides in the calibration"
 # The noise model of the step's variance: the identification's own (several time scales).
 _WINDOW = "exponential"
 # Blocks the colored variance is computed on (at most).
@@ -107,8 +115,10 @@ def check(flight, result, air_data):
     """
     from .jumps import jump_test
 
-    step_note, details = step_test(flight, result, air_data)
-    jump_note, details["jump"] = jump_test(flight)
+    jump_note, jump = jump_test(flight)
+    step_note, details = step_test(flight, result, air_data,
+                                   detectable_jump_pa=jump.get("detectable_pa"))
+    details["jump"] = jump
     hidden = None if jump_note else hidden_warning(flight.source, details)
     raw, width = _ratio(flight, result, air_data)
     ratio = _running(raw, width(COLLAPSE_WINDOW_S), median=True)
@@ -177,7 +187,8 @@ def _ratio(flight, result, air_data):
     return ratio / max(float(np.median(ratio)), 1e-12), width
 
 
-def step_test(flight, result, air_data):
+def step_test(flight, result, air_data, *, detectable_jump_pa=None,
+              hides_threshold_kt=HIDES_THRESHOLD_KT):
     """(warning or None, details): a change of q_ci's scale during the flight.
 
     Parameters
@@ -187,6 +198,12 @@ def step_test(flight, result, air_data):
     result : IdentificationResult
     air_data : str
         As `pitotcal.core.measurement.flight_channels` takes it.
+    detectable_jump_pa : float, optional
+        The smallest lasting jump of q_ci the abrupt-jump test catches at its power
+        (`jumps.detectable_jump_pa`, Pa); None: a sudden change is judged by this test alone.
+    hides_threshold_kt : float
+        The ΔV shift, kt, that a missed sudden change must exceed to be stated as hidden
+        (`HIDES_THRESHOLD_KT` by default).
 
     Returns
     -------
@@ -223,13 +240,49 @@ def step_test(flight, result, air_data):
     # the maneuver's geometry: the Gaussian bound of a scan of the steps it states alone
     # (`hidden_bound`), as the margin is for the noise model's tails
     n_mid = int(np.sum(ONSETS <= HIDDEN_LAST_ONSET + 1e-9))
-    hidden = _undetected(result, model, onsets[:n_mid], scan,
-                         hidden_bound(n_mid) + float(normal_isf(1 - POWER)))
-    details.update(undetected=hidden, hidden=bool(
-        hidden["dv_shift_kt"] > max(HIDDEN_RATIO * hidden["dv_2sigma_kt"], MIN_SHIFT_KT)))
+    z_detect = hidden_bound(n_mid) + float(normal_isf(1 - POWER))
+    hidden, sudden = _undetected(result, model, onsets[:n_mid], scan, z_detect,
+                                 _jump_steps(np.asarray(ch.qci, float), first[1:n_mid + 1],
+                                             detectable_jump_pa))
+    details.update(undetected=hidden, undetected_sudden=sudden)
+    details.update(hides(details, hides_threshold_kt))
     if details["flagged"]:
         return _change_warning(flight.source, details, t[-1]), details
     return None, details
+
+
+def hides(details, threshold_kt=HIDES_THRESHOLD_KT):
+    """{"hidden", "hides_threshold_kt"}: whether the maneuver hides a change of scale
+    (`step_test`'s `details`) at the user's threshold.
+
+    Hidden when both hold: the maneuver cannot tell a change of scale from the calibration
+    (the change the scan misses moves ΔV by more than `HIDDEN_RATIO` of its band and
+    `MIN_SHIFT_KT`: its geometry), and a sudden change (a leak) that neither the scan nor the
+    abrupt-jump test catches moves ΔV by more than `threshold_kt` (what matters to the user).
+    """
+    kt = hides_threshold(threshold_kt)
+    step, sudden = details["undetected"], details.get("undetected_sudden") \
+        or details["undetected"]
+    geometry = step["dv_shift_kt"] > max(HIDDEN_RATIO * step["dv_2sigma_kt"], MIN_SHIFT_KT)
+    return {"hidden": bool(geometry and sudden["dv_shift_kt"] > kt), "hides_threshold_kt": kt}
+
+
+def hides_threshold(value):
+    """`hides_threshold_kt` checked: a ΔV shift in kt, > 0 and at most `HIDES_THRESHOLD_MAX_KT`
+    (beyond any airspeed error a calibration is flown for: say "never" with it)."""
+    return checks.number("hides_threshold_kt", value, 0.0, HIDES_THRESHOLD_MAX_KT, lo_open=True)
+
+
+def _jump_steps(qci, first, detectable_pa):
+    """The smallest sudden change of scale the abrupt-jump test catches from each onset (the
+    first sample `first` of each), as a fraction of q_ci there (at least `jumps.MIN_STEP`,
+    below which it names none); None when the test did not run."""
+    from .jumps import MIN_STEP, SPAN
+
+    if detectable_pa is None or not np.isfinite(detectable_pa):
+        return None
+    local = np.array([np.median(qci[max(f - 10 * SPAN, 0):f + 10 * SPAN]) for f in first])
+    return np.maximum(detectable_pa / np.maximum(local, 1e-9), MIN_STEP)
 
 
 def t_bound(tail, dof):
@@ -314,14 +367,44 @@ def hidden_warning(source, details):
         return None
     hidden = details["undetected"]
     return (f"{source}: on this maneuver a change of q_ci's scale during the flight (a leak, "
-            f"icing, drift) hides in the calibration: one from about t = "
+            f"icing, drift) {HIDES}: one from about t = "
             f"{hidden['onset_s']:.0f} s on is caught in {100 * POWER:.0f}% of flights only from "
             f"{100 * hidden['step']:.1f}% up, and one of that size moves dV by "
             f"{hidden['dv_shift_kt']:.2f} kt at {hidden['vi_kt']:.0f} kt{_first_order(hidden)}, "
             f"{hidden['dv_shift_kt'] / hidden['dv_2sigma_reported_kt']:.1f} times the 2-sigma "
-            "band the result reports there; fly "
+            f"band the result reports there{_sudden(details)}; fly "
             "the speeds twice (plan a return sweep: up and back down the speed range) to tell "
             "the two apart")
+
+
+def _sudden(details):
+    """The warning's clause on the sudden change (a leak) both tests miss."""
+    sudden = details.get("undetected_sudden")
+    if not sudden:
+        return ""
+    return (f"; a sudden one (a leak) is caught only from {100 * sudden['step']:.1f}% up and "
+            f"moves dV by {sudden['dv_shift_kt']:.2f} kt at {sudden['vi_kt']:.0f} kt, more "
+            f"than the {details['hides_threshold_kt']:g} kt asked (`hides_threshold_kt`)")
+
+
+def with_hides_threshold(result, threshold_kt):
+    """`result` with its hidden-change statement (`hides`, `hidden_warning`) made again at
+    `threshold_kt`: the consistency details carry every number it needs, so nothing is
+    refitted."""
+    import dataclasses
+
+    found = result.consistency
+    if not found or "undetected" not in found:
+        hides_threshold(threshold_kt)
+        return result
+    found = {**found, **hides(found, threshold_kt)}
+    jumped = bool((found.get("jump") or {}).get("flagged"))
+    note = None if jumped else hidden_warning(result.source, found)
+    old = [i for i, w in enumerate(result.warnings) if HIDES in w]
+    warnings = [w for w in result.warnings if HIDES not in w]
+    if note:            # where the statement stood, or last
+        warnings.insert(old[0] if old else len(warnings), note)
+    return dataclasses.replace(result, consistency=found, warnings=tuple(warnings))
 
 
 def _first_order(hidden):
@@ -457,7 +540,7 @@ def _dv_shift_kt(model, k_shifted, vi_kt, dv_fit_kt, first_order_kt, air_data):
     return dv, linear
 
 
-def _undetected(result, model, onsets, scan, z_detect):
+def _undetected(result, model, onsets, scan, z_detect, sudden=None):
     """The onset where the smallest detected step, z_detect sigma, moves ΔV most against
     its 2-sigma band, and the numbers.
 
@@ -471,7 +554,10 @@ def _undetected(result, model, onsets, scan, z_detect):
     The fit that absorbs a step s at t0 sits between the calibration before (it is off it by
     the shift d_k s) and the one after (a change of scale over the whole record, d_all s): the
     error counted is the smaller of the two, so a step near either end of the record, which
-    leaves one calibration for most of it, is not counted as hidden.
+    leaves one calibration for most of it, is not counted as hidden. `sudden` (one fraction
+    per onset, `_jump_steps`): the abrupt-jump test's smallest caught change, which caps the
+    scan's where smaller; the second of the two results returned is for that change (the
+    first again when `sudden` is None).
     """
     from pitotcal.core.propagation import band as sigma_of
     from pitotcal.core.propagation import gradient
@@ -489,9 +575,9 @@ def _undetected(result, model, onsets, scan, z_detect):
     dv_fit = delta_v_kt(model, k, vi, result.air_data)
     grad = gradient(lambda kk: delta_v_kt(model, kk, vi, result.air_data), k)
     band = np.maximum(2.0 * sigma_of(grad, cov_k), 1e-12)
-    best = None
-    for i, onset in enumerate(onsets):
-        size = z_detect * scan["plain"][i] * np.sqrt(inflation)
+
+    def at(i, size):
+        """(ratio, numbers) of a step of `size` from onset i."""
         off = [scan["shift"][i, :nk] * size,                                   # from before
                (scan["shift"][i, :nk] - scan["shift_all"][:nk]) * size]        # from after
         shifts = [_dv_shift_kt(model, k - dk, vi, dv_fit, dk @ grad, result.air_data)
@@ -499,15 +585,23 @@ def _undetected(result, model, onsets, scan, z_detect):
         pick = int(np.argmin([np.max(d / band) for d, _ in shifts]))
         dk, (dv, linear) = off[pick], shifts[pick]
         j = int(np.argmax(dv / band))
-        if best is None or dv[j] / band[j] > best[0]:
-            k_sigma = float(np.sqrt(max(dk @ np.linalg.solve(cov_k, dk), 0.0)))
-            best = (dv[j] / band[j], {
-                "onset_s": float(onset), "step": float(size), "power": POWER,
-                "dv_shift_kt": float(dv[j]), "dv_2sigma_kt": float(band[j]),
-                "vi_kt": float(vi[j]), "k_shift_sigma": k_sigma,
-                # the band printed in the result's table at that speed (the warning's ratio)
-                "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"]),
-                # speeds where the shifted calibration has no V_c (beyond the Mach
-                # range of the pitot relations): its shift there is the first-order one
-                "first_order_vi_kt": [float(v) for v in vi[linear]]})
-    return best[1]
+        return dv[j] / band[j], {
+            "onset_s": float(onsets[i]), "step": float(size), "power": POWER,
+            "dv_shift_kt": float(dv[j]), "dv_2sigma_kt": float(band[j]),
+            "vi_kt": float(vi[j]),
+            "k_shift_sigma": float(np.sqrt(max(dk @ np.linalg.solve(cov_k, dk), 0.0))),
+            # the band printed in the result's table at that speed (the warning's ratio)
+            "dv_2sigma_reported_kt": float(rows[j]["dv_2sigma_kt"]),
+            # speeds where the shifted calibration has no V_c (beyond the Mach range of
+            # the pitot relations): its shift there is the first-order one
+            "first_order_vi_kt": [float(v) for v in vi[linear]]}
+
+    best = [None, None]
+    for i in range(len(onsets)):
+        size = z_detect * scan["plain"][i] * np.sqrt(inflation)
+        step = at(i, size)
+        quick = step if sudden is None or sudden[i] >= size else at(i, float(sudden[i]))
+        for n, got in enumerate((step, quick)):
+            if best[n] is None or got[0] > best[n][0]:
+                best[n] = got
+    return best[0][1], best[1][1]

@@ -21,7 +21,8 @@ import numpy as np
 
 from pitotcal.core.information import normal_isf
 
-__all__ = ["ALPHA", "CENTER", "GAP", "MARGIN", "MAX_HELD", "MIN_STEP", "SPAN", "jump_test"]
+__all__ = ["ALPHA", "CENTER", "GAP", "MARGIN", "MAX_HELD", "MIN_STEP", "POWER", "SPAN",
+           "detectable_jump_pa", "jump_test"]
 
 # The samples on each side of a jump whose medians are compared.
 SPAN = 5
@@ -31,6 +32,9 @@ CENTER = 25
 ALPHA = 0.01
 # Standard deviations added to the Gaussian bound for the heavier tails of flight residuals.
 MARGIN = 1.0
+# The detection probability at which the smallest flagged jump is stated (`detectable_jump_pa`,
+# used by the statement of what a maneuver hides).
+POWER = 0.95
 # Smallest jump named, as a fraction of q_ci (0.5 % of airspeed): on a quiet transducer a jump
 # of a few tenths of a pascal stands far above the noise (z = -39 for -0.3 Pa on a simulated
 # leg flight), but it moves no calibration; the leaks that matter are a few percent.
@@ -70,11 +74,11 @@ def jump_test(flight):
     # gap's difference is kept out of every running mean and scale
     dt = np.diff(flight.time_s)
     ok = dt <= GAP * np.median(dt)
-    z1 = _standardized(np.diff(r), ok)               # z1[i]: r[i+1] - r[i]
+    z1, scale1 = _standardized(np.diff(r), ok)       # z1[i]: r[i+1] - r[i]
     med = np.median(np.lib.stride_tricks.sliding_window_view(r, SPAN), axis=1)
     jump = med[SPAN:] - med[:-SPAN]                  # jump[k]: between k+SPAN-1 and k+SPAN
     straddles = np.convolve(~ok, np.ones(2 * SPAN - 1), "valid")[:jump.size] > 0
-    zm = _standardized(jump, ~straddles)
+    zm, scale_m = _standardized(jump, ~straddles)
     i = np.arange(SPAN - 1, SPAN - 1 + zm.size)      # the same jump's index in z1
     a = z1[i]
     stat = np.where(np.sign(a) == np.sign(zm), np.minimum(np.abs(a), np.abs(zm)), 0.0)
@@ -83,7 +87,8 @@ def jump_test(flight):
     step = float(-jump[k] / med[k])                  # against the median before the jump
     details = {"time_s": float(flight.time_s[at]), "jump_pa": float(jump[k]), "step": step,
                "z": float(np.sign(jump[k]) * stat[k]), "threshold": threshold,
-               "flagged": bool(stat[k] > threshold and abs(step) >= MIN_STEP)}
+               "flagged": bool(stat[k] > threshold and abs(step) >= MIN_STEP),
+               "detectable_pa": detectable_jump_pa(threshold, scale1, scale_m)}
     if not details["flagged"]:
         return None, details
     side = "low" if step > 0 else "high"
@@ -94,10 +99,22 @@ def jump_test(flight):
             "before and after it apart (`start_s`, `end_s`)"), details
 
 
+def detectable_jump_pa(threshold, scale1, scale_m, power=POWER):
+    """The smallest lasting jump of q_ci (Pa) the test flags in about `power` of flights: both
+    of its standardized differences must pass `threshold`, each with its own unit-variance
+    noise, so the jump stands (threshold + z_power) scales above the larger one; infinite
+    when a scale is unknown (no sample-to-sample spread)."""
+    scale = max(scale1, scale_m)
+    if not scale > 0.0:
+        return float("inf")
+    return float((threshold + normal_isf(1.0 - power)) * scale)
+
+
 def _standardized(d, ok):
-    """(d - its running mean over 2 CENTER + 1) / (1.4826 MAD) where `ok`, 0 elsewhere: a
-    robust z, unmoved by the few jumps sought; the running mean takes out the airspeed's own
-    rate of change, and the entries not `ok` (across a time gap) enter neither."""
+    """((d - its running mean over 2 CENTER + 1) / (1.4826 MAD) where `ok`, 0 elsewhere; the
+    scale 1.4826 MAD): a robust z, unmoved by the few jumps sought; the running mean takes out
+    the airspeed's own rate of change, and the entries not `ok` (across a time gap) enter
+    neither."""
     d = np.where(ok, d, 0.0)
     c = np.concatenate([[0.0], np.cumsum(d)])
     w = np.concatenate([[0], np.cumsum(ok)])
@@ -105,4 +122,4 @@ def _standardized(d, ok):
     hi = np.clip(np.arange(d.size) + CENTER + 1, 0, d.size)
     d = d - (c[hi] - c[lo]) / np.maximum(w[hi] - w[lo], 1)
     mad = 1.4826 * float(np.median(np.abs(d[ok]))) if ok.any() else 0.0
-    return np.where(ok, d / mad, 0.0) if mad > 0 else np.zeros_like(d)
+    return (np.where(ok, d / mad, 0.0) if mad > 0 else np.zeros_like(d)), mad

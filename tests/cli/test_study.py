@@ -35,7 +35,7 @@ def test_real_alfa_from_any_folder_with_the_environment_variable(shared_file, tm
     assert main(["study", "real-alfa", "--out", "out"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("study real-alfa: 1 run, 0 failed, ")
-    assert "  result: k1 = 0.167 ± 0.034 (2σ), ArduPilot ratio 1.96 ± 0.08" in out
+    assert "  result: k1 = 0.167 ± 0.038 (2σ), ArduPilot ratio 1.96 ± 0.09" in out
     assert {"real-alfa.csv", "real-alfa.json", "real-alfa.png", "real-alfa_tracks.csv"} <= {
         p.name for p in (tmp_path / "out").iterdir()}
 

@@ -9,7 +9,7 @@ after the summary; the JSON and figure are written first).
 
 from pathlib import Path
 
-from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA
+from pitotcal.core.scenario import AIR_DATA_MODES, DEFAULT_AIR_DATA, HIDES_THRESHOLD_KT
 
 from .identify_budget import add_budget_arguments, budget_inputs, sensor_options
 
@@ -76,6 +76,10 @@ def add_parser(subparsers):
     p.add_argument("--wind-knot-s", type=float, default=None, metavar="S",
                    help="knot spacing of the drifting wind, s (default: 300 s, or two of the "
                         "flight's orbits when it turns more slowly)")
+    p.add_argument("--hides-threshold-kt", type=float, default=HIDES_THRESHOLD_KT, metavar="KT",
+                   help="say that the maneuver hides a change of scale (a leak) only when one "
+                        "the consistency checks would miss moves dV by more than KT "
+                        "(default %(default)s)")
     _add_params_and_live(p)
     add_budget_arguments(p, _help_constants)
     # --- the GPS receiver's time-correlated velocity error, stated ---
@@ -155,6 +159,9 @@ def run(args):
     # the live options are checked with a file too: a NaN is no option anywhere
     idle_timeout_s(args.idle_s)
     positive("target_2sigma_kt", args.target_2sigma_kt)
+    from pitotcal.estimation.robustness.consistency import hides_threshold
+
+    hides_threshold(args.hides_threshold_kt)
     if args.misfit_tolerance_kt is not None:
         from pitotcal.estimation.reporting.autopilot_params import check_misfit_tolerance
 
@@ -252,6 +259,7 @@ def _identify_all(args, source, sensors, inputs):
     """(flight, autopilot, current parameters, every sensor's flight, their results): one
     sensor as `identify`; a log with two or more airspeed sensors fitted jointly, one wind."""
     from pitotcal.estimation import identify, identify_sensors
+    from pitotcal.estimation.robustness.consistency import hides_threshold, with_hides_threshold
     from pitotcal.io.sensors import other_sensor_flights
 
     flight, autopilot, current = _read(args, source)
@@ -259,11 +267,13 @@ def _identify_all(args, source, sensors, inputs):
     flights = [flight, *other_sensor_flights(source, flight, csv_columns=args.columns, single_only={
         "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m,
         "--wind drifting": args.wind == "drifting", "--wind-knot-s": args.wind_knot_s})]
-    fit = (identify_sensors(flights, model=args.model, air=args.air, budget=inputs,
-                            gps_noise_std_mps=args.gps_noise_mps) if len(flights) > 1 else
+    fit = ([with_hides_threshold(r, hides_threshold(args.hides_threshold_kt)) for r in
+            identify_sensors(flights, model=args.model, air=args.air, budget=inputs,
+                             gps_noise_std_mps=args.gps_noise_mps)] if len(flights) > 1 else
            [identify(flight, model=args.model, air=args.air, budget=inputs, probe_arm_m=arm_m,
                      gps_noise_std_mps=args.gps_noise_mps, wind=args.wind,
-                     wind_knot_s=args.wind_knot_s, **_gps_error(args))])
+                     wind_knot_s=args.wind_knot_s, hides_threshold_kt=args.hides_threshold_kt,
+                     **_gps_error(args))])
     return flight, autopilot, current, flights, fit
 
 

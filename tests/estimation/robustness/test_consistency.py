@@ -14,6 +14,7 @@ from pitotcal.estimation import identify
 from pitotcal.estimation.robustness import consistency
 from synthetic import synthetic_flight
 
+from pitotcal.core.errors import PitotcalError
 from pitotcal.core.flight import Flight
 from pitotcal.core.models import delta_v_kt, get_model
 
@@ -51,19 +52,48 @@ def sweep():
 
 
 def test_one_way_sweep_says_it_cannot_tell(sweep):
-    _, _, result = sweep
+    """Asked for 0.2 kt, the sweep says it hides a change: the scan misses one that moves ΔV
+    by several bands, and a sudden one the jump test misses (below its 1 % floor) moves ΔV
+    by more than 0.2 kt."""
+    flight, _, _ = sweep
+    result = identify(flight, air="incompressible", hides_threshold_kt=0.2)
     details = result.consistency
-    hidden = details["undetected"]
+    hidden, sudden = details["undetected"], details["undetected_sudden"]
     assert not details["flagged"] and details["hidden"]
+    assert details["hides_threshold_kt"] == 0.2
     assert hidden["dv_shift_kt"] > consistency.HIDDEN_RATIO * hidden["dv_2sigma_kt"]
+    assert sudden["step"] <= hidden["step"] and 0.2 < sudden["dv_shift_kt"] < 1.0
     note = [w for w in result.warnings if HIDES in w]
     assert len(note) == 1, result.warnings
     assert f"t = {hidden['onset_s']:.0f} s" in note[0]
     assert f"{100 * hidden['step']:.1f}% up" in note[0] and "plan a return sweep" in note[0]
+    assert f"{100 * sudden['step']:.1f}% up" in note[0] and "0.2 kt asked" in note[0]
     # in the JSON, strict
     out = json.loads(json.dumps(result.to_dict(), allow_nan=False))
     assert out["consistency"]["undetected"]["power"] == consistency.POWER
     assert out["consistency"]["hidden"] is True
+
+
+def test_default_threshold_keeps_quiet_when_a_leak_is_caught(sweep):
+    """At the default 1 kt the same sweep says nothing: a sudden change the checks miss moves
+    ΔV by less; made again at 0.2 kt from the details alone, the statement is identify's."""
+    flight, _, result = sweep
+    details = result.consistency
+    assert details["hides_threshold_kt"] == consistency.HIDES_THRESHOLD_KT == 1.0
+    assert not details["hidden"] and not [w for w in result.warnings if HIDES in w]
+    again = consistency.with_hides_threshold(result, 0.2)
+    asked = identify(flight, air="incompressible", hides_threshold_kt=0.2)
+    assert again.consistency["hidden"] and again.warnings == asked.warnings
+    assert consistency.with_hides_threshold(again, 1.0).warnings == result.warnings
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), "x"])
+def test_hides_threshold_is_checked(sweep, bad):
+    flight, _, result = sweep
+    with pytest.raises(PitotcalError, match="`?hides_threshold_kt"):
+        identify(flight, hides_threshold_kt=bad)
+    with pytest.raises(PitotcalError, match="`?hides_threshold_kt"):
+        consistency.with_hides_threshold(result, bad)
 
 
 def test_stated_shift_is_what_a_refit_does(sweep):

@@ -29,8 +29,10 @@ def test_leak_lean(tmp_path):
 def test_leak_full_size(tmp_path):
     """50 flights per case (~10 min on 2 cores): clean flights flagged in at most 5 % (plus
     the Monte Carlo's own slack: 6 of 50), a 3 % leak flagged in 95 % or more in calm air and
-    in 0.5 m/s turbulence on both maneuvers, the one-way sweep in turbulence saying that it
-    hides a change of scale and the up-and-down one not (docs/measured.md has the table)."""
+    in 0.5 m/s turbulence on both maneuvers; the one-way sweep saying that it hides a change
+    of scale where a 3 % leak goes unseen (1 m/s: the jump test catches a sudden change only
+    from ~4 %, which moves ΔV ~1.5 kt, beyond the default 1 kt) and not where the jump test
+    catches it (0.5 m/s: from ~2 %, ~0.75 kt), the up-and-down one never (docs/measured.md)."""
     summary = run_study("leak", runs=50, out_dir=tmp_path, workers=2, seed=0)
     for c in summary["cases"]:
         name = (c["plan"], c["turbulence_mps"], c["leak"])
@@ -39,4 +41,5 @@ def test_leak_full_size(tmp_path):
         elif c["turbulence_mps"] <= 0.5:
             assert c["flagged"] >= 0.95, name
         if c["turbulence_mps"] > 0 and c["leak"] == 0:
-            assert c["hidden"] >= 0.9 if c["plan"] == "one-way" else c["hidden"] <= 0.1, name
+            one_way_loud = c["plan"] == "one-way" and c["turbulence_mps"] >= 1.0
+            assert c["hidden"] >= 0.9 if one_way_loud else c["hidden"] <= 0.1, name

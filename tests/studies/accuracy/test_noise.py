@@ -7,7 +7,7 @@ import pytest
 from pitotcal.studies.catalog import STUDIES, run_study
 from pitotcal.studies.accuracy.noise import NOISE_CASES, PARAMETERS
 
-HEADLINE = r"truth inside ±2σ: (\S+: parameters \S+-\S+, rows \S+, rms z \d+\.\d\d(; )?){4}$"
+HEADLINE = r"truth inside ±2σ: (\S+: parameters \S+-\S+, rows \S+, rms z \d+\.\d\d(; )?){5}$"
 
 
 def test_noise_lean(tmp_path):
@@ -22,6 +22,7 @@ def test_noise_lean(tmp_path):
             # one flight: the truth within 3 sigma (rms z of one estimate = |z|)
             assert p["rms_z"] < 3.0 and p["median_2sigma"] > 0, (name, p)
         assert 0.0 <= case["rows_inside_2sigma"] <= 1.0
+        assert case["p90_dv_2sigma_max_kt"] >= case["median_dv_2sigma_max_kt"] > 0
     assert (tmp_path / "noise.png").exists()
     assert STUDIES["noise"].engines == ("own", "jsbsim")
 

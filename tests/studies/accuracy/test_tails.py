@@ -53,14 +53,16 @@ def test_joint_inside_matches_direct_draws():
 
 def test_seed_54_scored_against_truth():
     """The campaign's worst flight, reproduced: `plan --return`, `simulate --seed 54`,
-    `identify` put k1 4.1σ and k2 3.9σ from truth (a turbulence realisation: the same seed in
-    calm air is within 1.3σ); the ΔV rows tilt about the middle, 5 of 17 inside ±2σ and 9
-    inside U, where exact bands would hold all 17 at once 87 % of the time."""
+    `identify` put k1 3.8σ and k2 3.6σ from truth (4.1σ and 3.9σ before the noise model's
+    slow terms got their floor: its σ was the cell's 0.7th percentile; a turbulence
+    realisation: the same seed in calm air is within 1.3σ); the ΔV rows tilt about the
+    middle, 5 of 17 inside ±2σ and 10 inside U, where exact bands would hold all 17 at once
+    87 % of the time."""
     row = task(54, "up-and-down", 0.5)
-    assert row["k1_z"] == pytest.approx(-4.12, abs=0.05)
-    assert row["k2_z"] == pytest.approx(3.95, abs=0.05)
-    assert (row["n_rows"], row["rows_in_2sigma"], row["rows_in_u"]) == (17, 5, 9)
-    assert abs(row["row_z_mid"]) < 1.0 < 3.0 < abs(row["row_z_low"])
+    assert row["k1_z"] == pytest.approx(-3.76, abs=0.05)
+    assert row["k2_z"] == pytest.approx(3.61, abs=0.05)
+    assert (row["n_rows"], row["rows_in_2sigma"], row["rows_in_u"]) == (17, 5, 10)
+    assert abs(row["row_z_mid"]) < 1.0 < 2.5 < abs(row["row_z_low"])
     assert row["joint_expected_2sigma"] == pytest.approx(0.87, abs=0.03)
     calm, _ = get_flight(UP_AND_DOWN, {"turbulence_mps": 0.0, "air_data": "compressible"}, 54)
     from pitotcal.estimation import identify

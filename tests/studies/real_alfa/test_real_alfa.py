@@ -36,8 +36,8 @@ def test_summary_keys_and_files(alfa_summary):
 
 def test_headline(alfa_summary):
     s, _ = alfa_summary
-    assert s["headline"].startswith("k1 = 0.167 ± 0.034 (2σ), ArduPilot ratio 1.96 ± 0.08 "
-                                    "(the autopilot flew 1.898); wind 1.8 ± 0.5 m/s from 337")
+    assert s["headline"].startswith("k1 = 0.167 ± 0.038 (2σ), ArduPilot ratio 1.96 ± 0.09 "
+                                    "(the autopilot flew 1.898); wind 1.8 ± 0.6 m/s from 337")
 
 
 def test_calibration_plausible_and_compared(alfa_summary):
