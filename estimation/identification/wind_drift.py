@@ -297,25 +297,34 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
         return _constant(result, test, knot_s, "auto: Wald test"), notes
     if not np.all(np.isfinite(d)):
         return _fallback(result, test, knot_s, "its fit did not converge", notes)
-    try:
-        drifting, drift_notes = fit_constant(without_drift(flight, basis, d))
-    except PitotcalError as exc:        # the constant wind's calibration stands
-        return _fallback(result, test, knot_s, f"its fit failed: {exc}", notes)
-    if not drifting.success:
-        return _fallback(result, test, knot_s, "its fit did not converge", notes)
-    notes, model = drift_notes, get_model(drifting.model)
-    kept = _kept(without_drift(flight, basis, d), drifting)
-    ch = flight_channels(kept, drifting.gps_noise_std_mps, air_data)
-    b = basis.rows(kept.time_s, kept.segment)
-    cov = _covariances(model, drifting.internal_params, ch, b, drifting.residuals_pa, known)
-    out = _widened(drifting, cov)
-    track = wind_track(basis, out.internal_params, d, cov[0])
     chosen = "option" if wind == "drifting" else "auto: Wald test"
-    out = dataclasses.replace(out, wind_model=_model_record("drifting", knot_s, test, chosen,
-                                                            basis),
-                              wind_track=track, drift=(basis, d))
-    note = drift_note(out, track, result)
-    return out, tuple(notes) + ((note,) if note else ())
+    record = _model_record("drifting", knot_s, test, chosen, basis)
+    out, drift_notes = _given_wind(flight, fit_constant, basis, d, air_data, known, record)
+    if out is None:                     # the constant wind's calibration stands
+        return _fallback(result, test, knot_s, f"its fit {drift_notes}", notes)
+    note = drift_note(out, out.wind_track, result)
+    return out, tuple(drift_notes) + ((note,) if note else ())
+
+
+def _given_wind(flight, fit_constant, basis, d, air_data, known, record):
+    """(result, warnings) of the calibration with the wind B d (basis, d) taken out of the GPS
+    velocity, its covariance widened by the wind's freedom and its `wind_track`; (None, why)
+    when that fit fails."""
+    try:
+        out, notes = fit_constant(without_drift(flight, basis, d))
+    except PitotcalError as exc:
+        return None, f"failed: {exc}"
+    if not out.success or not np.all(np.isfinite(d)):
+        return None, "did not converge"
+    kept = _kept(without_drift(flight, basis, d), out)
+    ch = flight_channels(kept, out.gps_noise_std_mps, air_data)
+    b = basis.rows(kept.time_s, kept.segment)
+    cov = _covariances(get_model(out.model), out.internal_params, ch, b, out.residuals_pa,
+                       known)
+    out = _widened(out, cov)
+    track = wind_track(basis, out.internal_params, d, cov[0])
+    return dataclasses.replace(out, wind_model=record, wind_track=track, drift=(basis, d)), \
+        tuple(notes)
 
 
 def _fallback(result, test, knot_s, reason, notes):
@@ -337,24 +346,13 @@ def _per_window(flight, fit_constant, result, test, knot_s, chosen, fitted, note
     fit fails."""
     model, ch, kept, air_data, known = fitted
     basis = window_basis(kept.time_s, kept.segment)
-    b = basis.rows(kept.time_s, kept.segment)
-    d = _joint_gauss_newton(model, result.internal_params, ch, b)[1]
-    try:
-        each, each_notes = fit_constant(without_drift(flight, basis, d))
-    except PitotcalError as exc:
-        return _fallback(result, test, knot_s, f"per-window fit failed: {exc}", notes)
-    if not each.success or not np.all(np.isfinite(d)):
-        return _fallback(result, test, knot_s, "per-window fit did not converge", notes)
-    kept = _kept(without_drift(flight, basis, d), each)
-    ch = flight_channels(kept, each.gps_noise_std_mps, air_data)
-    b = basis.rows(kept.time_s, kept.segment)
-    cov = _covariances(model, each.internal_params, ch, b, each.residuals_pa, known)
-    out = _widened(each, cov)
-    track = wind_track(basis, out.internal_params, d, cov[0])
+    d = _joint_gauss_newton(model, result.internal_params, ch,
+                            basis.rows(kept.time_s, kept.segment))[1]
     record = _model_record("constant per window", knot_s, test, chosen, basis)
-    return dataclasses.replace(out, wind_model=record, wind_track=track, drift=(basis, d)), \
-        tuple(each_notes)
-
+    out, each_notes = _given_wind(flight, fit_constant, basis, d, air_data, known, record)
+    if out is None:
+        return _fallback(result, test, knot_s, f"per-window fit {each_notes}", notes)
+    return out, each_notes
 
 def _known(gps_error, time_s):
     if gps_error is None:
