@@ -34,7 +34,7 @@ from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND, to_reported
 
 __all__ = ["DEFAULT_KNOT_S", "DRIFT_MATTERS_MPS", "DRIFT_TEST_ALPHA", "WIND_MODES",
-           "DriftBasis", "check_wind_options", "fit_wind"]
+           "DriftBasis", "check_wind_options", "constant_wind", "fit_wind"]
 
 WIND_MODES = ("auto", "constant", "drifting")
 # Knot spacing of the drift, s: long against an orbit (1-3 min at 40-60 m/s on a 600-900 m
@@ -383,6 +383,12 @@ def _model_record(kind, knot_s, test, chosen_by, basis=None):
     if basis is not None:
         out["n_knots"] = int(sum(k.size for k in basis.knots))
     return out
+
+
+def constant_wind(result, chosen_by):
+    """`result` (its own constant wind, no drift) with a constant `wind_model` and a flat
+    `wind_track`, no test run."""
+    return _constant(result, None, None, chosen_by)
 
 
 def _constant(result, test, knot_s, chosen_by):
