@@ -128,10 +128,12 @@ class LiveIdentifier:
 
 def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None,
                     idle_timeout_s=IDLE_TIMEOUT_S, on_fix=None, max_s=None, air=DEFAULT_AIR_DATA,
-                    gps_error=None, temp_recovery=1.0, rh_pct=None, budget=None):
+                    gps_error=None, temp_recovery=1.0, rh_pct=None, budget=None,
+                    record_options=None):
     """Re-identify the growing maneuver every second (warm-started, `LiveIdentifier`); returns
     (final result, flight, fixes, stream buffer). The final result is `identify` (with `air`,
-    the stated `gps_error`, as `LiveIdentifier` takes it, and the uncertainty `budget`) on every
+    the stated `gps_error`, as `LiveIdentifier` takes it, the uncertainty `budget` and
+    `record_options`: identify's `wind`, `wind_knot_s`, `hides_threshold_kt`) on every
     sample received, as offline, so its record (`to_dict`) has the offline record's keys. The
     air data is made as `read_flight` makes it, with `temp_recovery` and `rh_pct`, and the
     flight's `reading` records it. Bad options are refused before the stream is opened."""
@@ -145,6 +147,7 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
     live = LiveIdentifier(model, air, gps_error)
     temp_recovery, rh_pct = check_air_options(temp_recovery, rh_pct)
     budget = budget_inputs(budget)
+    record_options = _record_options(record_options)
 
     def air_data(buf):
         return with_static_air(buf.flight(), temp_recovery=temp_recovery, rh_pct=rh_pct)
@@ -169,8 +172,27 @@ def identify_stream(source, *, model="inverse", target_2sigma_kt=1.0, oat_k=None
                       max_s=max_s)
     flight = with_reading(air_data(buf), {"start_s": None, "end_s": None, "oat_k": oat_k,
                                           "temp_recovery": temp_recovery, "rh_pct": rh_pct})
-    result = identify(flight, model=model, air=air, budget=budget, **live.gps_error)
+    result = identify(flight, model=model, air=air, budget=budget, **live.gps_error,
+                      **record_options)
     return result, flight, fixes, buf
+
+
+def _record_options(options):
+    """identify's final-record options (`identify_stream`), checked before the stream opens."""
+    from pitotcal.core.checks import option_dict
+
+    from .identification.wind_drift import check_wind_options
+    from .robustness.consistency import hides_threshold
+
+    options = option_dict("record_options", options)
+    unknown = sorted(set(options) - {"wind", "wind_knot_s", "hides_threshold_kt"})
+    if unknown:
+        raise PitotcalError(f"`record_options`: unknown key {unknown[0]!r}; known: wind, "
+                            "wind_knot_s, hides_threshold_kt", param="record_options")
+    check_wind_options(options.get("wind", "auto"), options.get("wind_knot_s"))
+    if options.get("hides_threshold_kt") is not None:
+        hides_threshold(options["hides_threshold_kt"])
+    return {k: v for k, v in options.items() if v is not None}
 
 
 def _fix(result, flight, update_s, target):

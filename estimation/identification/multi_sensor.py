@@ -46,6 +46,7 @@ from .identify import budget_inputs, complete
 from .oe import DEFAULT_IPOPT_OPTIONS, objective_function
 from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND_NAMES, theta_scales, to_reported
+from .wind_drift import constant_wind
 
 __all__ = ["identify_sensors", "joint_note", "sensors_record", "sensors_summary"]
 
@@ -233,13 +234,16 @@ def _sensor_result(part, i, parts, theta, cov, stats, colored, elapsed):
     if not success:
         warn += (f"the joint fit of the sensors did not converge ({message}); the numbers "
                  "are not a calibration",)
-    return dataclasses.replace(
+    # the joint fit has one constant wind: the single fit's drift or per-window winds (its
+    # wind_model, wind_track, drift) are not this result's, nor the budget's flight
+    joint = dataclasses.replace(
         part.single, params=params, covariance=cov_rep, covariance_plain=plain_rep,
         internal_params=th, internal_covariance=c, internal_covariance_plain=plain,
         residuals_pa=r, noise_std_pa=float(np.sqrt(np.mean(r ** 2))), success=success,
         message=message, iterations=int(stats.get("iter_count", 0)), warnings=warn,
         param_names=tuple(part.model.params) + WIND_NAMES,
-        timing_s={**part.single.timing_s, "joint": elapsed})
+        timing_s={**part.single.timing_s, "joint": elapsed}, drift=None)
+    return constant_wind(joint, "one wind shared by the sensors' joint fit")
 
 
 def joint_note(i, n_sensors):

@@ -82,14 +82,16 @@ class IdentificationResult:
     n_dropped : int
         Rows (or log samples) the reader dropped.
     wind_model : dict or None
-        How the wind was modelled (`estimation.identification.wind_drift`): {kind ("constant"
-        or "drifting"), knot_s, test (the Wald test of no drift, or None), chosen_by}.
+        How the wind was modelled (`estimation.identification.wind_drift`): {kind ("constant",
+        "constant per window" or "drifting"), knot_s, test (the Wald test of no drift, or
+        None), chosen_by}.
     wind_track : dict or None
         The wind along the record: {time_s, speed_mps, from_deg, speed_2sigma_mps,
         from_2sigma_deg[, segment]} (two points for a constant wind).
     drift : (DriftBasis, ndarray) or None
-        The fitted drift of a drifting wind (`wind_drift.without_drift` takes it out of a
-        flight's GPS velocity); None for a constant wind.
+        The fitted drift of a drifting wind or of one wind per window
+        (`wind_drift.without_drift` takes it out of a flight's GPS velocity); None for a
+        constant wind.
     """
 
     model: str

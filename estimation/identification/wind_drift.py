@@ -34,7 +34,7 @@ from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND, to_reported
 
 __all__ = ["DEFAULT_KNOT_S", "DRIFT_MATTERS_MPS", "DRIFT_TEST_ALPHA", "WIND_MODES",
-           "DriftBasis", "check_wind_options", "fit_wind"]
+           "DriftBasis", "check_wind_options", "constant_wind", "fit_wind"]
 
 WIND_MODES = ("auto", "constant", "drifting")
 # Knot spacing of the drift, s: long against an orbit (1-3 min at 40-60 m/s on a 600-900 m
@@ -65,11 +65,20 @@ class DriftBasis:
         Each column's mean over the record (subtracted: W_mean stays the time-average).
     knot_s : float
         The requested knot spacing, s.
+    labels : tuple of int or None
+        The `Flight.segment` value of each window (None: 0, 1, ...): a flight cut to some of
+        a log's windows keeps their numbers.
     """
 
     knots: tuple
     means: np.ndarray
     knot_s: float
+    labels: tuple | None = None
+
+    @property
+    def window_labels(self):
+        """The `Flight.segment` value of each window, in window order."""
+        return tuple(range(len(self.knots))) if self.labels is None else self.labels
 
     @property
     def size(self):
@@ -81,7 +90,7 @@ class DriftBasis:
         time_s = np.asarray(time_s, dtype=float)
         seg = np.zeros(time_s.size, dtype=int) if segment is None else np.asarray(segment)
         cols = []
-        for s, knots in enumerate(self.knots):
+        for s, knots in zip(self.window_labels, self.knots):
             inside = seg == s
             for j in range(knots.size):
                 unit = np.zeros(knots.size)
@@ -111,26 +120,29 @@ def drift_basis(time_s, segment, knot_s):
     """The `DriftBasis` of a record: knots about `knot_s` s apart or more in each window (at
     least its two ends: a linear drift), the last column dropped (centred hats sum to zero)."""
     seg = np.zeros(time_s.size, dtype=int) if segment is None else np.asarray(segment, int)
+    labels = tuple(int(s) for s in np.unique(seg))
     knots = []
-    for s in range(int(seg.max()) + 1):
+    for s in labels:
         t = time_s[seg == s]
         if t.size < 2 or t[-1] <= t[0]:
-            knots.append(np.array([t[0] if t.size else 0.0, (t[0] if t.size else 0.0) + 1.0]))
+            knots.append(np.array([t[0], t[0] + 1.0]))
             continue
         n_int = max(1, int((t[-1] - t[0]) // knot_s))
         knots.append(np.linspace(t[0], t[-1], n_int + 1))
-    raw = DriftBasis(tuple(knots), np.zeros(sum(k.size for k in knots) - 1), float(knot_s))
+    raw = DriftBasis(tuple(knots), np.zeros(sum(k.size for k in knots) - 1), float(knot_s),
+                     labels)
     means = np.mean(raw.rows(time_s, seg), axis=0)
-    return DriftBasis(raw.knots, means, float(knot_s))
+    return dataclasses.replace(raw, means=means)
 
 
 def window_basis(time_s, segment):
     """One wind per calibration window: a centred indicator column per window (one knot each,
     the last column dropped), for several windows whose wind has no drift within them."""
     seg = np.asarray(segment, int)
-    knots = tuple(time_s[seg == s][:1] for s in range(int(seg.max()) + 1))
-    raw = DriftBasis(knots, np.zeros(len(knots) - 1), 0.0)
-    return DriftBasis(knots, np.mean(raw.rows(time_s, seg), axis=0), 0.0)
+    labels = tuple(int(s) for s in np.unique(seg))
+    knots = tuple(time_s[seg == s][:1] for s in labels)
+    raw = DriftBasis(knots, np.zeros(len(knots) - 1), 0.0, labels)
+    return dataclasses.replace(raw, means=np.mean(raw.rows(time_s, seg), axis=0))
 
 
 def check_wind_options(wind, knot_s):
@@ -337,7 +349,7 @@ def _fallback(result, test, knot_s, reason, notes):
 
 
 def _windows(flight):
-    return 1 if flight.segment is None or not flight.n else int(np.max(flight.segment)) + 1
+    return 1 if flight.segment is None or not flight.n else np.unique(flight.segment).size
 
 
 def _per_window(flight, fit_constant, result, test, knot_s, chosen, fitted, notes):
@@ -383,6 +395,12 @@ def _model_record(kind, knot_s, test, chosen_by, basis=None):
     return out
 
 
+def constant_wind(result, chosen_by):
+    """`result` (its own constant wind, no drift) with a constant `wind_model` and a flat
+    `wind_track`, no test run."""
+    return _constant(result, None, None, chosen_by)
+
+
 def _constant(result, test, knot_s, chosen_by):
     """The constant-wind result with its `wind_model` and a flat `wind_track`."""
     p = result.internal_params.size
@@ -401,7 +419,7 @@ def wind_track(basis, theta, d, cov_whole):
     p = theta.size
     m = basis.size
     times, segs = [], []
-    for s, knots in enumerate(basis.knots):
+    for s, knots in zip(basis.window_labels, basis.knots):
         n = (knots.size - 1) * TRACK_POINTS_PER_KNOT + 1
         times.append(np.linspace(knots[0], knots[-1], n))
         segs.append(np.full(n, s))

@@ -117,6 +117,16 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
     }
 
 
+def _wind_options(result):
+    """identify's `wind` and `wind_knot_s` that refit the result's wind model: a drifting wind
+    with its knots; a constant wind (one per window with several) as it was; {} for a record
+    without a wind model (the default, as identify had then)."""
+    kind = (result.get("wind_model") or {}).get("kind")
+    if kind == "drifting":
+        return {"wind": "drifting", "wind_knot_s": result["wind_model"].get("knot_s")}
+    return {"wind": "constant"} if kind in ("constant", "constant per window") else {}
+
+
 def _reproduces(result, ident):
     """A warning when the fit re-run on the given flight is not the result's."""
     out = []
@@ -350,7 +360,8 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
                          gps_noise_std_mps=result.get("gps_noise_std_mps"),
                          gps_error_sigma_mps=stated.get("sigma_mps"),
                          gps_error_tau_s=stated.get("tau_s"),
-                         probe_arm_m=(result.get("reading") or {}).get("probe_arm_m") or 0.0)
+                         probe_arm_m=(result.get("reading") or {}).get("probe_arm_m") or 0.0,
+                         **_wind_options(result))
         inputs.append(("Flight", flight_path))
     rows, rule = (), {"configuration": None, "speeds_kcas": {}}
     if aircraft_path is not None:

@@ -159,6 +159,24 @@ def test_report_refits_with_the_probe_lever_arm_identify_corrected(identified, t
     assert "does not reproduce" not in html.read_text()
 
 
+def test_report_refits_with_the_wind_model_identify_used(tmp_path):
+    """identify --wind drifting --wind-knot-s 100 records the drift; `report --flight` fits the
+    same drift, so its re-fit reproduces the result (it re-fitted with the default wind, the
+    constant one the Wald test keeps here: k1 0.0263 against the result's 0.0200, truth 0.02,
+    on this seeded 300-s flight in 0.3 m/s turbulence)."""
+    flight, _ = synthetic_flight(seed=3, n=3000, turns=3.0, gps_noise_mps=0.1,
+                                 turbulence_mps=0.3)
+    csv, result, html = tmp_path / "f.csv", tmp_path / "drift.json", tmp_path / "r.html"
+    write_flight_csv(flight, csv)
+    assert main(["identify", str(csv), "--wind", "drifting", "--wind-knot-s", "100",
+                 "--no-budget", "--json", str(result)]) == 0
+    record = json.loads(result.read_text())
+    assert record["wind_model"]["kind"] == "drifting" and record["wind_model"]["knot_s"] == 100
+    assert abs(record["parameters"]["k1"]["value"] - 0.02) < 2 * record["parameters"]["k1"]["std"]
+    assert main(["report", str(result), "--flight", str(csv), "-o", str(html)]) == 0
+    assert "does not reproduce" not in html.read_text()
+
+
 def test_report_warnings_in_json_and_stderr(tmp_path, capsys):
     res, out_json = tmp_path / "res.json", tmp_path / "r.json"
     res.write_text(json.dumps(result_json(dv_kt=-1.0)))       # no dv_U_kt: no expanded U

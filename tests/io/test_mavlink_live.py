@@ -13,7 +13,7 @@ from pitotcal.maneuvers import simulate
 from pitotcal.maneuvers.fly.faults import Fault, apply_fault
 from plans import circle_plan
 
-from pitotcal.core.errors import FlightDataError
+from pitotcal.core.errors import FlightDataError, PitotcalError
 from pitotcal.io.mavlink_live import FIRST_MESSAGE_TIMEOUT_S, MavlinkFlightBuffer, read_stream
 
 # The monitor designs its tests before it listens (0.2-0.7 s on a loaded machine): UDP sent
@@ -59,6 +59,25 @@ def test_identify_stream_equals_file(flights):
     offline = identify(clean, air="incompressible")
     np.testing.assert_allclose(result.params, offline.params, rtol=1e-6, atol=1e-9)
     assert got.n == clean.n
+
+
+def test_identify_stream_final_record_takes_identify_options(flights):
+    """`record_options` (identify --live --wind / --wind-knot-s / --hides-threshold-kt): the
+    final record is identify's with them, as offline; a bad one is refused before the stream
+    opens."""
+    _, flight = flights
+    clean = flight.window(None, 89.0)
+    options = {"wind": "drifting", "wind_knot_s": 40.0, "hides_threshold_kt": 0.5}
+    with pytest.raises(PitotcalError, match="wind_knot_s"):
+        identify_stream("udpin:127.0.0.1:1", record_options={"wind_knot_s": 1.0})
+    port = free_udp_port()
+    send_flight(clean, port)
+    result, _, _, _ = identify_stream(f"udpin:127.0.0.1:{port}", idle_timeout_s=1.0,
+                                      air="incompressible", record_options=options)
+    offline = identify(clean, air="incompressible", **options)
+    assert result.wind_model["kind"] == "drifting" and result.wind_model["knot_s"] == 40.0
+    np.testing.assert_allclose(result.params, offline.params, rtol=1e-6, atol=1e-9)
+    assert result.to_dict()["consistency"] == offline.to_dict()["consistency"]
 
 
 def test_out_of_order_and_missing_streams():

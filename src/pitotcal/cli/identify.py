@@ -443,7 +443,9 @@ def _run_live(args):
         args.live, model=args.model, target_2sigma_kt=args.target_2sigma_kt,
         oat_k=oat_k, idle_timeout_s=idle_s,
         on_fix=show, air=args.air, gps_error=_gps_error(args), temp_recovery=args.temp_recovery,
-        rh_pct=args.rh_percent, budget=None if args.no_budget else budget_inputs(args))
+        rh_pct=args.rh_percent, budget=None if args.no_budget else budget_inputs(args),
+        record_options={"wind": args.wind, "wind_knot_s": args.wind_knot_s,
+                        "hides_threshold_kt": args.hides_threshold_kt})
     # the record is the offline one (the library's), plus how the stream went
     if args.json is not None:
         from pitotcal.io.jsonfile import write_json

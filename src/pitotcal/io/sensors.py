@@ -52,12 +52,17 @@ def other_sensor_flights(path, flight, *, csv_columns=None, single_only=None):
                                 temp_recovery=reading.get("temp_recovery", 1.0),
                                 rh_pct=reading.get("rh_pct"),
                                 oat_ground_k=reading.get("oat_ground_k"))
-    return [in_windows(other, reading.get("windows")) for other in others]
+    return [in_windows(other, reading.get("windows"), first=flight) for other in others]
 
 
-def in_windows(flight, windows):
+def in_windows(flight, windows, first=None):
     """`flight`'s samples inside the first sensor's calibration `windows` (`Flight.reading`
-    ``windows``: start_s, end_s), each window its `Flight.segment`; `flight` when None."""
+    ``windows``: start_s, end_s), each window its `Flight.segment`; `flight` when None.
+
+    With `first` (the first sensor's flight), also only the samples within one of its sample
+    steps of a sample it kept: what the steady-flight cuts took out inside a window (a steep
+    turn, a full-throttle climb: the aircraft's state, not the sensor's) goes for every sensor.
+    """
     if not windows:
         return flight
     import numpy as np
@@ -65,6 +70,12 @@ def in_windows(flight, windows):
     segment = np.full(flight.n, -1)
     for i, w in enumerate(windows):
         segment[(flight.time_s >= w["start_s"]) & (flight.time_s <= w["end_s"])] = i
+    if first is not None and first.n > 1:
+        kept_t = np.asarray(first.time_s, float)
+        step = float(np.median(np.diff(kept_t)))
+        at = np.clip(np.searchsorted(kept_t, flight.time_s), 1, kept_t.size - 1)
+        gap = np.minimum(np.abs(flight.time_s - kept_t[at - 1]), np.abs(kept_t[at] - flight.time_s))
+        segment[gap > step] = -1
     inside = dataclasses.replace(flight, segment=segment if len(windows) > 1 else None)
     return inside.select(segment >= 0)
 

@@ -52,6 +52,23 @@ def test_sensors_on_shifted_time_bases(two):
     assert np.isfinite(ra.covariance).all()
 
 
+def test_windows_keep_one_shared_constant_wind_in_the_record(two):
+    """Two calibration windows (`Flight.segment`): each sensor's own fit keeps a wind per
+    window, the joint fit one wind; the record says the joint fit's wind, with no drift for
+    the budget to take out of the flight."""
+    import dataclasses
+
+    fa, fb, truth = two
+    fa, fb = (dataclasses.replace(f, segment=(f.time_s > 300.0).astype(int)) for f in (fa, fb))
+    assert identify(fa, air="incompressible", budget=None).wind_model["kind"] != "constant"
+    for res in identify_sensors([fa, fb], air="incompressible"):
+        assert res.drift is None and res.wind_model["kind"] == "constant"
+        assert res.wind_model["test"] is None
+        assert res.wind_track["speed_mps"] == [res.value("wind_speed_mps")] * 2
+        assert abs(res.value("wind_speed_mps") - truth["parameters"]["wind_speed_mps"]) \
+            < 2.0 * res.stddev("wind_speed_mps")
+
+
 def coverage(n_flights, **flight_kw):
     """(raw rms z of k1, k2 of both sensors and the wind; 2-sigma coverage of each; rms k1
     error joint and alone; median sigma(k1) joint / alone) over seeded two-sensor flights."""

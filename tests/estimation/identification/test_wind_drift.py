@@ -194,3 +194,31 @@ def test_windows_keep_their_own_wind_with_a_constant_wind_in_each():
     assert abs(result.params[0] - k1) < 3 * result.stddev("k1")
     assert abs(result.params[1] - k2) < 3 * result.stddev("k2")
     assert "wind per calibration window" in result.summary()
+
+
+def test_a_flight_cut_to_some_windows_keeps_their_numbers():
+    """Windows 1 and 3 of three (`Flight.segment` 1 and 3, none 0 or 2), each a constant wind
+    of its own (5 m/s from 270°, 8 m/s from 200°): one wind per window present, the track
+    under their own numbers; window 3 alone is one window (a constant wind)."""
+    import dataclasses
+
+    from synthetic import synthetic_flight
+
+    from pitotcal.core.flight import Flight
+
+    one, truth = synthetic_flight(seed=3, n=4000, gps_noise_mps=0.05)
+    two, _ = synthetic_flight(seed=4, n=4000, wind_speed_mps=8.0, wind_from_deg=200.0,
+                              gps_noise_mps=0.05)
+    two = dataclasses.replace(two, time_s=two.time_s + one.time_s[-1] + 600.0)
+    both = Flight(**{name: np.concatenate([getattr(one, name), getattr(two, name)])
+                     for name in ("time_s", "qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3")},
+                  segment=np.repeat([1, 3], [one.n, two.n]))
+    result = identify(both, air="incompressible", wind="constant", budget=None)
+    track = result.wind_track
+    assert result.wind_model["kind"] == "constant per window" and track["segment"] == [1, 3]
+    for speed, got, u in zip((5.0, 8.0), track["speed_mps"], track["speed_2sigma_mps"]):
+        assert abs(got - speed) < max(1.5 * u, 0.1)
+    assert abs(result.params[0] - truth["k"][0]) < 3 * result.stddev("k1")
+    last = identify(both.select(both.segment == 3), air="incompressible", budget=None)
+    assert last.wind_model["kind"] == "constant"
+    assert abs(last.value("wind_speed_mps") - 8.0) < 0.1
