@@ -90,8 +90,27 @@ def make_flights(kind, seeds, tmp):
                          else everyday_flight(seed, drifting=kind == "drifting"))
         path = Path(tmp) / f"{kind}_{seed}.csv"
         write_flight_csv(flight, path)
-        out.append((path, truth_of(flight, truth)))
+        case = truth_of(flight, truth)
+        if kind == "drifting":          # the oracle's flight: the true drift taken out
+            case["oracle_csv"] = Path(tmp) / f"{kind}_{seed}_oracle.csv"
+            write_flight_csv(without_true_drift(flight, case), case["oracle_csv"])
+        out.append((path, case))
     return out
+
+
+def without_true_drift(flight, case):
+    """`flight` with the true process wind's drift (about its mean) taken out of the GPS
+    velocity: a constant wind is then exact, so a constant-wind fit of it is what the best
+    wind model could give (the oracle row)."""
+    import dataclasses
+
+    pn, pe = process_wind(case, flight.time_s)
+    return dataclasses.replace(flight, gps_vn_mps=flight.gps_vn_mps - (pn - pn.mean()),
+                               gps_ve_mps=flight.gps_ve_mps - (pe - pe.mean()))
+
+
+# The drifting flights' oracle: `pitotcal identify --model inverse` told the true wind track
+ORACLE = "oracle: inverse, true wind track"
 
 
 def commands(csv, out_json, core, identify_args=()):
@@ -150,7 +169,7 @@ def _vectors(speed, from_deg):
 
 def answer(name, stdout, out_json):
     """{ratio?, dv(grid) function, wind track} of one tool's output."""
-    if name.startswith("pitotcal"):
+    if name.startswith("pitotcal") or name == ORACLE:
         d = json.loads(Path(out_json).read_text())
         t, wn, we = wind_pitotcal(d)
         return {"dv": lambda g, d=d: dv_pitotcal(d, g), "wind": (t, wn, we),
@@ -193,11 +212,19 @@ def bench_flights(flights, core, tmp, identify_args=()):
     rows = {}
     for csv, case in flights:
         out_json = Path(tmp) / f"{csv.stem}.json"
-        for name, cmd in commands(csv, out_json, core, identify_args).items():
+        cmds = commands(csv, out_json, core, identify_args)
+        if "oracle_csv" in case:
+            cmds[ORACLE] = [sys.executable, "-m", "pitotcal", "identify", str(case["oracle_csv"]),
+                            "--json", str(out_json), "--model", "inverse", "--wind", "constant"]
+        for name, cmd in cmds.items():
             try:
                 wall, rss, stdout = run_child(cmd)
-                row = {**score(answer(name, stdout, out_json), case), "wall_s": wall,
-                       "peak_mb": rss}
+                ans = answer(name, stdout, out_json)
+                if name == ORACLE:          # its wind: the fitted mean plus the true drift
+                    pn, pe = process_wind(case, case["time_s"])
+                    ans["wind"] = (case["time_s"], ans["wind"][1][0] + pn - pn.mean(),
+                                   ans["wind"][2][0] + pe - pe.mean())
+                row = {**score(ans, case), "wall_s": wall, "peak_mb": rss}
             except (RuntimeError, ValueError, KeyError) as exc:
                 row = {"error": str(exc)[-300:]}
             rows.setdefault(name, []).append({"flight": csv.stem, **row})

@@ -24,7 +24,7 @@ def run(tmp_path_factory):
 
 def test_every_tool_it_has_is_timed_and_scored(run):
     data, text = run
-    tools = {"pitotcal inverse", "pitotcal constant"}
+    tools = {"pitotcal inverse", "pitotcal constant", "oracle: inverse, true wind track"}
     if data["skipped"] is None:
         tools |= {"AirspeedFit constant", "AirspeedFit drifting"}
     else:
@@ -51,6 +51,17 @@ def test_the_answers_are_near_the_truth_and_the_drift_is_seen(run):
     if data["skipped"] is None:
         assert s["AirspeedFit drifting"]["dv_err_max_kt_median"] < 0.6
         assert s["AirspeedFit drifting"]["wind_track_rms_mps_median"] < 1.0
+
+
+def test_the_oracle_knows_the_wind_and_is_scored_like_the_tools(run):
+    """The oracle (the true drift taken out, then a constant-wind inverse fit) has the true
+    wind track but for its mean's error, and its ΔV error is of the tools' size."""
+    data, _ = run
+    oracle = data["summary"]["drifting"]["oracle: inverse, true wind track"]
+    assert oracle["wind_track_rms_mps_median"] < 0.3
+    assert oracle["wind_track_rms_mps_median"] == pytest.approx(
+        oracle["wind_mean_err_mps_median"], abs=0.05)
+    assert oracle["dv_err_max_kt_median"] < 0.6
 
 
 @pytest.mark.slow
