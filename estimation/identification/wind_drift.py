@@ -280,6 +280,7 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
         {time_s, speed_mps, from_deg, speed_2sigma_mps, from_2sigma_deg, segment}.
     """
     result, notes = fit_constant(flight)
+    result = dataclasses.replace(result, source=str(flight.source))   # the warnings name it
     if wind == "constant" or not result.success:
         chosen = "option" if wind == "constant" else "the constant fit did not converge"
         if result.success and _windows(flight) > 1:
@@ -335,8 +336,8 @@ def _given_wind(flight, fit_constant, basis, d, air_data, known, record):
                        known)
     out = _widened(out, cov)
     track = wind_track(basis, out.internal_params, d, cov[0])
-    return dataclasses.replace(out, wind_model=record, wind_track=track, drift=(basis, d)), \
-        tuple(notes)
+    return dataclasses.replace(out, wind_model=record, wind_track=track, drift=(basis, d),
+                               source=str(flight.source)), tuple(notes)
 
 
 def _fallback(result, test, knot_s, reason, notes):

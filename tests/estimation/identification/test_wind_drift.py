@@ -37,7 +37,10 @@ def test_each_window_keeps_a_wind_of_its_own():
 
 @pytest.fixture(scope="module")
 def drifting():
+    import dataclasses
+
     flight, truth = loiter_flight(seed=1)
+    flight = dataclasses.replace(flight, source="loiter.csv")
     return flight, truth, identify(flight)
 
 
@@ -49,6 +52,7 @@ def test_drift_is_chosen_warned_and_recovered(drifting):
     assert result.wind_model["test"]["p_value"] < 1e-6
     note = [w for w in result.warnings if "the wind drifted" in w]
     assert len(note) == 1 and "fitted as a drifting wind" in note[0]
+    assert note[0].startswith("loiter.csv: the wind drifted")      # the flight's name
     true_k = [truth.parameters[p] for p in ("k1", "k2")]
     z = (result.coefficients - true_k) / np.sqrt(np.diag(result.internal_covariance)[:2])
     assert np.all(np.abs(z) < 2.5), z
