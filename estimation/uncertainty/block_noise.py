@@ -24,6 +24,8 @@ _MIN_PER_BLOCK = 4     # samples a block needs (the detrended variance has n - 2
 # lags and decorrelate faster at long ones than one AR(1) coefficient (fitted at lag one) says:
 # AR(2) follows both, and the ramp test's information grows by ~20 % (docs/measured.md).
 AR_ORDER = 2
+# A block's relative variance below this is numerical zero (a relative std of 1e-6)
+BAND_REL_VAR_FLOOR = 1e-12
 
 
 @dataclass(frozen=True)
@@ -103,7 +105,9 @@ def block_residual_stats(result, block_s=BLOCK_S):
     a, phi, w = _ar_model(e)
     dv = airspeed_residual_mps(e, pred_b)      # the same in airspeed: the monitor's unit
     _, phi_v, w_v = _ar_model(dv - dv.mean())
-    log_band = np.log(blocks.band_rel_var)
+    # floored: a noise-free record (a synthetic one) has blocks of zero variance, whose log
+    # would be -inf in the record and warn on the console
+    log_band = np.log(np.maximum(blocks.band_rel_var, BAND_REL_VAR_FLOOR))
     return {"block_s": block_s, "rel_std": float(np.std(e)), "ar1": a, "ar": list(phi),
             "innovation_rel_std": robust_std(w),
             "std_mps": float(np.std(dv)), "ar_mps": list(phi_v),
