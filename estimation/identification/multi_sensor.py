@@ -39,11 +39,11 @@ from pitotcal.core.measurement import DEFAULT_AIR_DATA
 from pitotcal.core.models import get_model
 from pitotcal.core.processes import solver_interrupts
 
-from ..uncertainty.covariance import colored_covariance
+from ..uncertainty.covariance import colored_covariance, plain_covariance
 from ..uncertainty.residual_noise import _inv_sym
 from .fit import _air_data, fit
 from .identify import budget_inputs, complete
-from .oe import DEFAULT_IPOPT_OPTIONS, objective_function
+from .oe import DEFAULT_IPOPT_OPTIONS, objective_function, objective_inputs
 from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND_NAMES, theta_scales, to_reported
 from .wind_drift import constant_wind
@@ -139,13 +139,8 @@ def _solve(parts, options):
         data = [ca.MX.sym(name, n) for name in obj.name_in()[1:-4]]
         noise = [ca.MX.sym(name) for name in obj.name_in()[-4:]]
         total = total + obj(ca.vertcat(x[sl], x[-2:]), *data, *noise)
-        ch = p.ch
-        values = {"qci": ch.qci, "vn": ch.vn, "ve": ch.ve, "rho": ch.rho, "vd2": ch.vd2,
-                  "pt": ch.pt, "oat": ch.oat, "ps_ref": ch.ps_ref, "c_eiv": ch.c_eiv,
-                  "pen_a": 4.0 * ch.var_v, "pen_b": 2.0 * ch.n_comp * ch.var_v ** 2,
-                  "weight": n / (n_mean * p.sigma2)}
         p_syms += data + noise
-        p_vals += [np.atleast_1d(values[name]) for name in obj.name_in()[1:]]
+        p_vals += objective_inputs(p.ch, n / (n_mean * p.sigma2), obj.name_in()[1:])
     solver = ca.nlpsol("oe_sensors", "ipopt", {"x": x, "p": ca.vertcat(*p_syms), "f": total},
                        {"ipopt": options, "print_time": False})
     start = np.concatenate([p.single.internal_params[:-2] for p in parts]
@@ -223,7 +218,7 @@ def _sensor_result(part, i, parts, theta, cov, stats, colored, elapsed):
     th, c = theta[idx], cov[np.ix_(idx, idx)]
     r = residual(part.model, th, *part.ch.args)
     jac = sensitivities(part.model, th, *part.ch.args)
-    plain = float(r @ r) / max(r.size - th.size, 1) * _inv_sym(jac.T @ jac)
+    plain = plain_covariance(jac, r)
     params, cov_rep = to_reported(th, c)
     _, plain_rep = to_reported(th, plain)
     success = bool(stats.get("success", False))

@@ -21,7 +21,12 @@ from pitotcal.core.measurement import AIR_CHANNELS, IncompressibleAir, as_air, t
 from pitotcal.core.models import get_model
 from pitotcal.core.processes import solver_interrupts
 
-from ..uncertainty.covariance import ColoredCovariance, colored_covariance, plain_covariance
+from ..uncertainty.covariance import (
+    ColoredCovariance,
+    colored_covariance,
+    known_gps_error,
+    plain_covariance,
+)
 from .iv import IV_NOT_CONVERGED, IV_WINDOW_S, iv_refine, smooth_in_time
 from .residual import (
     flight_channels,
@@ -33,7 +38,8 @@ from .residual import (
 from .result import IdentificationResult
 from .unknowns import WIND_NAMES, theta_scales, to_reported
 
-__all__ = ["DEFAULT_IPOPT_OPTIONS", "OutputErrorProblem", "objective_function", "start_values"]
+__all__ = ["DEFAULT_IPOPT_OPTIONS", "OutputErrorProblem", "objective_function",
+           "objective_inputs", "start_values"]
 
 log = logging.getLogger(__name__)
 
@@ -244,14 +250,21 @@ def _minimise(model, built, ch, theta0):
     # robust scale of the start residuals: makes J ~ O(1) whatever the noise level
     s0 = 1.4826 * np.median(np.abs(r0 - np.median(r0)))
     s0 = max(s0, 1e-6 * float(np.mean(ch.qci)), 1e-9)
+    weight = 1.0 / s0 ** 2
+    p_val = ca.DM(np.concatenate(objective_inputs(ch, weight, built.p_names)))
+    with solver_interrupts():
+        sol = built.solver(x0=theta0 / theta_scales(model), p=p_val)
+    return np.asarray(sol["x"]).ravel(), p_val, weight, built.solver.stats()
+
+
+def objective_inputs(ch, weight, names):
+    """The values of `objective_function`'s inputs `names` (after x), each a 1-d array: the
+    data channels of `ch` (`flight_channels`), its GPS-noise terms and the weight."""
     values = {"qci": ch.qci, "vn": ch.vn, "ve": ch.ve, "rho": ch.rho, "vd2": ch.vd2,
               "pt": ch.pt, "oat": ch.oat, "ps_ref": ch.ps_ref,
               "c_eiv": ch.c_eiv, "pen_a": 4.0 * ch.var_v,
-              "pen_b": 2.0 * ch.n_comp * ch.var_v ** 2, "weight": 1.0 / s0 ** 2}
-    p_val = ca.DM(np.concatenate([np.atleast_1d(values[name]) for name in built.p_names]))
-    with solver_interrupts():
-        sol = built.solver(x0=theta0 / theta_scales(model), p=p_val)
-    return np.asarray(sol["x"]).ravel(), p_val, values["weight"], built.solver.stats()
+              "pen_b": 2.0 * ch.n_comp * ch.var_v ** 2, "weight": weight}
+    return [np.atleast_1d(values[name]) for name in names]
 
 
 def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None, colored=True):
@@ -269,8 +282,7 @@ def _refine(model, built, x_opt, p_val, weight, ch, time_s, gps_error=None, colo
         theta, jac = theta_iv, jac_iv
     residuals = residual(model, theta, *ch.args)
     cov_plain = plain_covariance(jac, residuals, information=info)
-    known = None if gps_error is None else (    # tau in samples of the median interval
-        gps_error[0], gps_error[1] / max(float(np.median(np.diff(time_s))), 1e-9))
+    known = known_gps_error(gps_error, time_s)
     cov = ColoredCovariance(cov_plain, 0, "none (not computed)", 0.0) if not colored else \
         colored_covariance(jac, residuals, velocity=jac[:, -2:], known_velocity=known,
                            information=info if instruments is None else instruments.T @ jac,

@@ -29,7 +29,7 @@ from pitotcal.core.errors import PitotcalError
 from pitotcal.core.models import get_model
 from pitotcal.core.units import wind_polar
 
-from ..uncertainty.covariance import colored_covariance
+from ..uncertainty.covariance import colored_covariance, known_gps_error, plain_covariance
 from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND, to_reported
 
@@ -220,9 +220,7 @@ def _covariances(model, theta, ch, b, r, known, test_only=False):
     for jac in (full,) if test_only else (full, full[:, :p]):
         colored = colored_covariance(jac, r, velocity=jac[:, p - 2:p], known_velocity=known,
                                      window="multiscale")
-        s2 = float(r @ r) / max(r.size - jac.shape[1], 1)
-        plain = s2 * np.linalg.pinv(jac.T @ jac)
-        out += [colored.covariance, plain]
+        out += [colored.covariance, plain_covariance(jac, r)]
     return tuple(out)
 
 
@@ -281,55 +279,51 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
     """
     result, notes = fit_constant(flight)
     result = dataclasses.replace(result, source=str(flight.source))   # the warnings name it
-    if wind == "constant" or not result.success:
+    if not result.success or (wind == "constant" and _windows(flight) < 2):
         chosen = "option" if wind == "constant" else "the constant fit did not converge"
-        if result.success and _windows(flight) > 1:
-            kept = _kept(flight, result)
-            ch = flight_channels(kept, result.gps_noise_std_mps, air_data)
-            return _per_window(flight, fit_constant, result, None, knot_s, chosen,
-                               (get_model(result.model), ch, kept, air_data,
-                                _known(gps_error, kept.time_s)), notes)
         return _constant(result, None, knot_s, chosen), notes
     kept = _kept(flight, result)
-    knot_s = default_knot_s(kept) if knot_s is None else knot_s
-    basis = drift_basis(kept.time_s, kept.segment, knot_s)
     model = get_model(result.model)
     sigma = result.gps_noise_std_mps if gps_noise_std_mps is None else gps_noise_std_mps
     ch = flight_channels(kept, sigma, air_data)
+    fitted = (model, ch, kept, air_data, known_gps_error(gps_error, kept.time_s))
+    if wind == "constant":              # several windows: still a wind for each
+        return _per_window(flight, fit_constant, result, None, knot_s, "option", fitted, notes)
+    knot_s = default_knot_s(kept) if knot_s is None else knot_s
+    basis = drift_basis(kept.time_s, kept.segment, knot_s)
     b = basis.rows(kept.time_s, kept.segment)
     theta, d = _joint_gauss_newton(model, result.internal_params, ch, b)
-    known = _known(gps_error, kept.time_s)
     r = residual(model, theta, *_args(_shifted(ch, b, d)))
-    cov = _covariances(model, theta, _shifted(ch, b, d), b, r, known, test_only=True)
+    cov = _covariances(model, theta, _shifted(ch, b, d), b, r, fitted[-1], test_only=True)
     p = theta.size
     test = wald_test(d, cov[0][p:, p:])
     if wind == "auto" and not test["p_value"] < DRIFT_TEST_ALPHA:
         if _windows(kept) > 1:          # no drift within them: still a wind for each
             return _per_window(flight, fit_constant, result, test, knot_s, "auto: Wald test",
-                               (model, ch, kept, air_data, known), notes)
+                               fitted, notes)
         return _constant(result, test, knot_s, "auto: Wald test"), notes
-    if not np.all(np.isfinite(d)):
-        return _fallback(result, test, knot_s, "its fit did not converge", notes)
     chosen = "option" if wind == "drifting" else "auto: Wald test"
     record = _model_record("drifting", knot_s, test, chosen, basis)
-    out, drift_notes = _given_wind(flight, fit_constant, basis, d, air_data, known, record)
+    out, drift_notes = _given_wind(flight, fit_constant, basis, d, air_data, fitted[-1], record)
     if out is None:                     # the constant wind's calibration stands
         return _fallback(result, test, knot_s, f"its fit {drift_notes}", notes)
     note = drift_note(out, out.wind_track, result)
     return out, tuple(drift_notes) + ((note,) if note else ())
 
-
 def _given_wind(flight, fit_constant, basis, d, air_data, known, record):
     """(result, warnings) of the calibration with the wind B d (basis, d) taken out of the GPS
     velocity, its covariance widened by the wind's freedom and its `wind_track`; (None, why)
     when that fit fails."""
+    if not np.all(np.isfinite(d)):
+        return None, "did not converge"
+    corrected = without_drift(flight, basis, d)
     try:
-        out, notes = fit_constant(without_drift(flight, basis, d))
+        out, notes = fit_constant(corrected)
     except PitotcalError as exc:
         return None, f"failed: {exc}"
-    if not out.success or not np.all(np.isfinite(d)):
+    if not out.success:
         return None, "did not converge"
-    kept = _kept(without_drift(flight, basis, d), out)
+    kept = _kept(corrected, out)
     ch = flight_channels(kept, out.gps_noise_std_mps, air_data)
     b = basis.rows(kept.time_s, kept.segment)
     cov = _covariances(get_model(out.model), out.internal_params, ch, b, out.residuals_pa,
@@ -366,11 +360,6 @@ def _per_window(flight, fit_constant, result, test, knot_s, chosen, fitted, note
     if out is None:
         return _fallback(result, test, knot_s, f"per-window fit {each_notes}", notes)
     return out, each_notes
-
-def _known(gps_error, time_s):
-    if gps_error is None:
-        return None
-    return gps_error[0], gps_error[1] / max(float(np.median(np.diff(time_s))), 1e-9)
 
 
 def _widened(result, cov):

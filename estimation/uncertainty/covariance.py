@@ -16,6 +16,7 @@ from .residual_noise import _fast_len, _inv_sym, block_means, residual_acf
 __all__ = [
     "ColoredCovariance",
     "colored_covariance",
+    "known_gps_error",
     "lag_weights",
     "plain_covariance",
     "residual_acf",
@@ -28,6 +29,13 @@ MIN_STRETCHES = 10
 # A lag window shorter than this cannot describe even sample-and-hold GPS at 5 Hz in 50 Hz data.
 MIN_LAG = 10
 
+
+def known_gps_error(gps_error, time_s):
+    """A stated GPS velocity error (sigma_mps, tau_s) as `colored_covariance` takes it (`known_velocity`), tau in
+    samples of the median interval; None when none is stated."""
+    if gps_error is None:
+        return None
+    return gps_error[0], gps_error[1] / max(float(np.median(np.diff(time_s))), 1e-9)
 
 def plain_covariance(jac, residuals, information=None):
     """Plain (Cramer-Rao) covariance s^2 M^-1, M = J^T J or the given information matrix.
