@@ -24,6 +24,7 @@ from types import MappingProxyType
 import numpy as np
 
 from pitotcal.core.checks import integer, number
+from pitotcal.core.dynamics import ground_speed_on_track_mps
 from pitotcal.core.errors import PitotcalError
 from pitotcal.core.plan import Plan
 from pitotcal.core.speeds import cas_from_tas_mps, qc_from_tas_isa_pa, tas_from_cas_mps
@@ -103,12 +104,6 @@ def _on_pattern(s_m, pieces, track0_rad):
     return north, east, track
 
 
-def _ground_speed(track_rad, tas_mps, wn, we):
-    """Ground speed along `track_rad` whose air velocity closes the wind triangle."""
-    along = wn * np.cos(track_rad) + we * np.sin(track_rad)
-    return along + np.sqrt(tas_mps ** 2 - (wn * wn + we * we - along ** 2))
-
-
 def _tas_schedule(t, cfg, rng):
     """True airspeed (m/s) at `t`: the levels in a seeded order, each change at accel_max."""
     n_levels = max(2, int(math.ceil(cfg["duration_s"] / cfg["level_s"])))
@@ -159,12 +154,14 @@ def everyday_plan(seed=0, wind=DRIFTING_WIND, **settings):
             tm = t[k] + (j + 0.5) * h
             v = np.interp(tm, t, tas)
             wn, we = wind_at(tm, wind, duration)
-            half = sk + 0.5 * h * _ground_speed(_on_pattern([sk], pieces, track0)[2][0], v, wn, we)
-            sk = sk + h * _ground_speed(_on_pattern([half], pieces, track0)[2][0], v, wn, we)
+            half = sk + 0.5 * h * ground_speed_on_track_mps(
+                _on_pattern([sk], pieces, track0)[2][0], v, wn, we)
+            sk = sk + h * ground_speed_on_track_mps(
+                _on_pattern([half], pieces, track0)[2][0], v, wn, we)
         s[k + 1] = sk
     north, east, track = _on_pattern(s, pieces, track0)
     wn, we = wind_at(t, wind, duration)
-    vg = _ground_speed(track, tas, wn, we)
+    vg = ground_speed_on_track_mps(track, tas, wn, we)
     heading = np.unwrap(np.arctan2(vg * np.sin(track) - we, vg * np.cos(track) - wn))
     bank = np.arctan(tas * np.gradient(heading, t) / G0_MPS2)
     alt = np.full(t.size, cfg["altitude_m"])

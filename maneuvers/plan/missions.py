@@ -22,6 +22,7 @@ import numpy as np
 
 from pitotcal.core.airdata import cas_from_qc_mps
 from pitotcal.core.checks import choice, number
+from pitotcal.core.dynamics import ground_speed_on_track_mps
 from pitotcal.core.errors import PlanInfeasibleError
 from pitotcal.core.geo import check_lat_lon
 from pitotcal.core.plan import Plan
@@ -157,27 +158,19 @@ def speed_levels(plan):
         n += step
 
 
-def _ground_speed(track_rad, tas_mps, wind_ne, wind_speed):
-    """Ground speed along a track angle: the air velocity closes the triangle with the wind."""
-    to = math.atan2(wind_ne[1], wind_ne[0])
-    cross = wind_speed * np.sin(track_rad - to)
-    return wind_speed * np.cos(track_rad - to) + np.sqrt(tas_mps ** 2 - cross ** 2)
-
-
 def _fly_circle(time_s, tas_mps, radius_m, wind_ne, track0_rad, sign=1.0):
     """Track angle and air heading (rad, unwrapped) flying a ground-fixed circle of `radius_m`
     from track `track0_rad` (a scalar, or one start per column), turning right (`sign` +1) or
     left (-1): d(chi)/dt = sign V_g(chi)/R, midpoint rule on the time grid, V_g closing the
     wind triangle with the true airspeed (one value per time)."""
-    wind_speed = float(np.hypot(*wind_ne))
     tracks = [np.asarray(track0_rad, dtype=float)]
     for k, dt in enumerate(np.diff(time_s)):
         tas, track = 0.5 * (tas_mps[k] + tas_mps[k + 1]), tracks[-1]
-        half = track + sign * 0.5 * dt * _ground_speed(track, tas, wind_ne, wind_speed) / radius_m
-        tracks.append(track + sign * dt * _ground_speed(half, tas, wind_ne, wind_speed) / radius_m)
+        half = track + sign * 0.5 * dt * ground_speed_on_track_mps(track, tas, *wind_ne) / radius_m
+        tracks.append(track + sign * dt * ground_speed_on_track_mps(half, tas, *wind_ne) / radius_m)
     track = np.array(tracks)
     tas = np.asarray(tas_mps).reshape((-1,) + (1,) * (track.ndim - 1))
-    vg = _ground_speed(track, tas, wind_ne, wind_speed)
+    vg = ground_speed_on_track_mps(track, tas, *wind_ne)
     heading = np.unwrap(np.arctan2(vg * np.sin(track) - wind_ne[1],
                                    vg * np.cos(track) - wind_ne[0]), axis=0)
     return track, heading

@@ -15,7 +15,7 @@ import numpy as np
 from .scenario import ALT_TOLERANCE_FT, CAS_TOLERANCE_KT
 from .units import FT_TO_M, G0_MPS2
 
-__all__ = ["CONTROL_NAMES", "STATE_NAMES", "Limits", "rhs"]
+__all__ = ["CONTROL_NAMES", "STATE_NAMES", "Limits", "ground_speed_on_track_mps", "rhs"]
 
 STATE_NAMES = ("north_m", "east_m", "alt_m", "heading_rad", "tas_mps")
 CONTROL_NAMES = ("bank_rad", "accel_mps2", "climb_mps")
@@ -43,3 +43,13 @@ def rhs(x, u, w, lib=np):
     phi, accel, climb = u[0], u[1], u[2]
     return (v * lib.cos(psi) + w[0], v * lib.sin(psi) + w[1], climb,
             G0_MPS2 * lib.tan(phi) / v, accel)
+
+
+def ground_speed_on_track_mps(track_rad, tas_mps, wind_n_mps, wind_e_mps):
+    """Ground speed along the track angle `track_rad` (rad from north) of an aircraft at true
+    airspeed `tas_mps` in the wind (wind_n, wind_e; the way it blows TO): the air velocity
+    closes the wind triangle, V_g = w_along + sqrt(V^2 - w_across^2); arrays broadcast."""
+    cos, sin = np.cos(track_rad), np.sin(track_rad)
+    along = wind_n_mps * cos + wind_e_mps * sin
+    across = wind_e_mps * cos - wind_n_mps * sin
+    return along + np.sqrt(tas_mps ** 2 - across ** 2)
