@@ -242,7 +242,8 @@ def _incompressible_note(result, flight):
     if result.air_data != "incompressible":
         return None
     wind = wind_vector_mps(result.value("wind_speed_mps"), result.value("wind_from_deg"))
-    mach = float(np.nanpercentile(flight_mach(flight, *wind), 99))
+    with np.errstate(over="ignore", invalid="ignore"):     # a gated absurd sample: inf
+        mach = float(np.nanpercentile(flight_mach(flight, *wind), 99))
     if not mach > INCOMPRESSIBLE_MACH_MAX:
         return None
     return (f"{result.source}: fitted with the incompressible air data (q_c = ½ρV_t²) up to "

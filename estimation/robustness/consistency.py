@@ -503,10 +503,12 @@ def _scan(jac, r, g, threshold):
     beta = np.array([c[-1] for c in coef])
     # residual sum of squares of each augmented fit by the normal equations
     s2 = np.array([max(rr - c @ xr[idx], 0.0) for c, idx in zip(coef, cols)]) / max(n - p - 1, 1)
-    sigma = np.sqrt(s2 * np.array([mk[-1, -1] for mk in inv_k]))
+    # rounding can make a variance of noise-free data a hair negative: zero, and no test
+    sigma = np.sqrt(s2 * np.clip([mk[-1, -1] for mk in inv_k], 0.0, None))
     plain = sigma.copy()
     dof = float("inf")
-    best = int(np.argmax(np.abs(beta[1:]) / sigma[1:])) + 1
+    z = np.divide(np.abs(beta[1:]), sigma[1:], out=np.zeros(m - 1), where=sigma[1:] > 0)
+    best = int(np.argmax(z)) + 1
     if abs(beta[best]) > threshold * sigma[best]:
         x = np.column_stack([jac, g.column(best)])
         # on block means of `b` samples: the regressors are smooth over a block (the step is

@@ -243,3 +243,16 @@ def test_held_qci_is_not_tested():
     flight, _ = synthetic_flight(seed=9, n=2000, quantization_pa=5.0)
     warning, details = jump_test(flight)
     assert warning is None and "held or quantized" in details["skipped"]
+
+
+def test_noise_free_flight_has_no_numeric_warning():
+    """On a noise-free flight the change test's variances round to a hair below zero: it says
+    nothing (no warning in the record, no RuntimeWarning on the console) and k is exact."""
+    import warnings
+
+    flight, truth = synthetic_flight(seed=1, n=4000, rate_hz=10.0, qc_noise_pa=0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        res = identify(flight, air="incompressible")
+    assert res.warnings == ()
+    assert abs(res.value("k2") - truth["k"][1]) < 1e-6
