@@ -14,6 +14,7 @@ import numpy as np
 
 from pitotcal.core import airdata
 from pitotcal.core.checks import integer, number
+from pitotcal.core.dynamics import ground_speed_on_track_mps
 from pitotcal.core.measurement import StaticAir
 from pitotcal.core.models import get_model
 from pitotcal.core.units import FT_TO_M, KT_TO_MPS, isa_temperature_k, wind_vector_mps
@@ -92,11 +93,11 @@ def simulate_legs(ias_kt=(70, 85, 100, 115, 130, 145, 160), tracks_deg=(0, 90, 1
     wn, we = wind_vector_mps(wind_speed_kt * KT_TO_MPS, wind_from_deg)
     w = np.array([float(wn), float(we)])
     u = np.column_stack([np.cos(np.radians(tracks)), np.sin(np.radians(tracks))])
-    along, across = u @ w, u[:, 0] * w[1] - u[:, 1] * w[0]
+    # ground speed of each point (rows) on each track (columns)
+    gs = ground_speed_on_track_mps(np.radians(tracks)[None, :], tas[:, None], *w)
     rows = {"point": [], "g": [], "ias": [], "alt": []}
-    for p, v in enumerate(tas):
-        gs = along + np.sqrt(v ** 2 - across ** 2)       # ground speed on each track
-        g = gs[:, None] * u + rng.normal(0.0, leg_sd, size=u.shape)
+    for p in range(tas.size):
+        g = gs[p][:, None] * u + rng.normal(0.0, leg_sd, size=u.shape)
         rows["point"] += [str(p + 1)] * len(tracks)
         rows["g"].append(g)
         rows["ias"] += [ias[p]] * len(tracks)
