@@ -90,7 +90,7 @@ def _scan(path):
     """Read the wanted messages: ({type: columns}, params, firmware, log start, bytes skipped)."""
     from pymavlink import mavutil
 
-    from .streams import captured_output
+    from .streams import MAVLINK_READ_ERRORS, captured_output, skipped_bytes
 
     name = Path(path).name
     collectors, firmware, n_data, t_first = {}, None, 0, np.inf
@@ -128,12 +128,10 @@ def _scan(path):
             log.close()
     except FlightDataError:
         raise
-    except (ValueError, OSError, IndexError, KeyError, TypeError, UnicodeDecodeError,
-            AttributeError) as exc:
-        # pymavlink fails on empty / mangled files with assorted low-level errors.
+    except MAVLINK_READ_ERRORS as exc:
         raise FlightDataError(f"{name}: not a readable DataFlash log ({exc}); "
                               "truncated or corrupt?") from None
-    skipped = sum(map(int, re.findall(r"Skipped (\d+) bad bytes", chatter.getvalue())))
+    skipped = skipped_bytes(chatter.getvalue())
     if n_data == 0:
         raise FlightDataError(f"{name}: no data messages in the log; "
                               "truncated or corrupt file?")

@@ -4,6 +4,8 @@ guard that catches what the log libraries print."""
 import contextlib
 import io
 import os
+import re
+import struct
 import sys
 import tempfile
 import warnings
@@ -11,10 +13,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["LOG_EXTENSIONS", "LogStreams", "captured_output"]
+__all__ = ["LOG_EXTENSIONS", "MAVLINK_READ_ERRORS", "LogStreams", "captured_output",
+           "skipped_bytes"]
 
 # The autopilot log formats pitotcal reads (anything else is read as a flight CSV).
 LOG_EXTENSIONS = (".ulg", ".bin", ".log", ".tlog")
+# What pymavlink raises on an empty, truncated or mangled file (its parsers fail low down)
+MAVLINK_READ_ERRORS = (ValueError, OSError, IndexError, KeyError, TypeError, UnicodeDecodeError,
+                       AttributeError, struct.error)
+
+
+def skipped_bytes(chatter):
+    """The bad bytes pymavlink says it skipped, summed over its "Skipped N bad bytes" lines."""
+    return sum(map(int, re.findall(r"Skipped (\d+) bad bytes", chatter)))
 
 
 @contextlib.contextmanager

@@ -35,14 +35,13 @@ the ratio under test (or a synthetic estimate without a sensor).
 """
 
 import re
-import struct
 from pathlib import Path
 
 import numpy as np
 
 from pitotcal.core.errors import FlightDataError
 
-from .streams import LogStreams, captured_output
+from .streams import MAVLINK_READ_ERRORS, LogStreams, captured_output, skipped_bytes
 
 __all__ = ["AIRSPEED_PARAMS", "read_tlog_streams"]
 
@@ -96,11 +95,10 @@ def _scan(path):
                 elif kind == "STATUSTEXT" and firmware is None and _FIRMWARE.match(msg.text or ""):
                     firmware = msg.text.strip()
             log.close()
-    except (ValueError, OSError, IndexError, KeyError, TypeError, UnicodeDecodeError,
-            AttributeError, struct.error) as exc:
+    except MAVLINK_READ_ERRORS as exc:
         raise FlightDataError(f"{name}: not a readable MAVLink telemetry log ({exc}); "
                               "truncated or corrupt?") from None
-    skipped = sum(map(int, re.findall(r"Skipped (\d+) bad bytes", chatter.getvalue())))
+    skipped = skipped_bytes(chatter.getvalue())
     if n_msgs == 0:
         raise FlightDataError(f"{name}: no MAVLink messages in the telemetry log; "
                               "truncated or corrupt file?")
