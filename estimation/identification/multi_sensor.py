@@ -1,4 +1,4 @@
-"""Two or more airspeed sensors in one flight: one shared wind, one calibration per sensor.
+"""Two or more airspeed sensors in one flight: one shared wind model, one calibration per sensor.
 
 Each sensor's q_ci is its own measured output of the one measurement model: the sensors see the
 same air mass through the same GPS ground velocity, so the wind is one unknown of all of them,
@@ -7,25 +7,42 @@ output-error problem and returns one `IdentificationResult` per sensor (the shar
 
 Notes
 -----
-Unknowns theta = [k_1..., k_2..., ..., wind_n, wind_e]. The objective is the sum of the
-single-sensor objectives (`oe.objective_function`, the corrected score), each on its own samples
-with its own noise weight, the wind entries of x shared:
+The wind is the first sensor's wind model, W(t) = W_mean + B(t) d (`wind_drift`): its fit alone
+(`fit.fit`, with `wind` and `wind_knot_s`) chooses a constant wind, one wind per calibration
+window or a drift, and that basis B is every sensor's, evaluated at its own sample times.
+Unknowns x = (theta, d), theta = [k_1..., k_2..., ..., wind_n, wind_e]
+(`multi_sensor_wind`). Every other sensor is first fitted alone with the first sensor's drift
+taken out of its GPS velocity (its checks, gates and outlier trimming: the joint problem uses
+the samples that fit kept, and starts from its estimate). Then:
 
-    J = sum_s n_s / (n̄ sigma_s²) J_s(k_s, W),   J_s = mean_i [r_s,i² − spread_s,i],
+1. (theta, d) by Gauss-Newton on all sensors' residuals, each weighted by 1 / sigma_s, from the
+   first sensor's d (`multi_sensor_wind.joint_gauss_newton`; skipped for a constant wind): a
+   full Gauss-Newton, not one step, because it costs a few sensitivity evaluations and d is
+   then the joint problem's, not the first sensor's alone;
+2. theta given d by IPOPT on the sum of the single-sensor objectives (`oe.objective_function`,
+   the corrected score), each on its own samples with its own noise weight, the wind shared:
 
-i.e. weighted least squares with each sensor's residual variance sigma_s² (from its own fit).
-Every sensor is first fitted alone by `fit.fit` (its checks, gates and outlier trimming: the
-joint problem uses the samples that fit kept, and starts from its estimate).
+       J = sum_s n_s / (n̄ sigma_s²) J_s(k_s, W),   J_s = mean_i [r_s,i² − spread_s,i],
 
-Bounds: the sandwich of the whole problem, M⁻¹ Ω M⁻¹ with M = sum_s S_sᵀ S_s / sigma_s². The
-sensors' weighted residuals and sensitivities are put on the first sensor's time steps (each
-sample onto its nearest step) and rotated into orthonormal channels per step: their sum (the
-turbulence and GPS error all sensors see alike) and contrasts (mostly each sensor's own white
-noise). The score sum_s S_sᵀ r_s is unchanged by the rotation, and Ω is the sum over channels
-of the single-sensor colored-residual middle (`uncertainty.covariance.colored_covariance`,
-multiscale, with the information set to I), each channel's sensitivities first reduced to
-their independent directions (in every channel the k1 columns of all sensors are one column:
-dr/dk1 follows from the shared wind and GPS alone).
+   i.e. weighted least squares with each sensor's residual variance sigma_s² (its own fit);
+3. the instrumental-variable step (`multi_sensor_wind.joint_iv`, as `iv.iv_refine` for one
+   sensor): each sensor's coefficient rows on its instruments Z_s, the mean-wind and drift
+   rows the weighted sum of the sensors' corrected scores, solved in (theta, d) together.
+
+Bounds: the sandwich of the whole problem, A⁻¹ Ω A⁻ᵀ with A = sum_s Z_sᵀ S_s / sigma_s² (the
+sensitivities S_s and instruments Z_s in the columns of x, d included; Z_s = S_s when the
+instrumental-variable step did not converge). The sensors' weighted residuals,
+sensitivities and instruments are put on the first sensor's time steps (each sample onto its
+nearest step) and rotated into orthonormal channels per step: their sum (the turbulence and
+GPS error all sensors see alike) and contrasts (mostly each sensor's own white noise). The
+estimating equations sum_s Z_sᵀ r_s are unchanged by the rotation, and Ω is the sum over
+channels of the single-sensor colored-residual middle built from the channel's instruments
+(`uncertainty.covariance.colored_covariance` with `instruments`, multiscale, the information
+set to I), its noise model fitted at the channel's sensitivities reduced to their independent
+directions (in every channel the k1 columns of all sensors are one column: dr/dk1 follows
+from the shared wind and GPS alone). Each sensor's `covariance` is the block of (k_s, W_mean)
+of that whole covariance, so it includes the wind's freedom; its `wind_track` is the shared
+wind with the 2σ from the block of (W_mean, d).
 """
 
 import dataclasses
