@@ -6,11 +6,13 @@ Cases:
 - ``windows``: two calibration windows 600 s apart (`synthetic.two_window_sensor_flights`,
   300 s each at 10 Hz, 0.5 m/s turbulence), 5 m/s from 270° and 8 m/s from 300°;
 - ``drifting``: 900 s at 10 Hz (`synthetic.two_sensor_flights`, 8 turns, 0.5 m/s
-  turbulence), the wind drifting linearly from 5 m/s from 260° to 7.5 m/s from 300° (3.7 m/s
-  of the vector);
+  turbulence), the wind drifting linearly from 5 m/s from 260° to 7.5 m/s from 300° (2.5 m/s
+  in speed, 40° in direction, 4.9 m/s of the vector);
 - ``turbulence``: the simulator (`maneuvers.fly.simulator.simulate`: the speed loop puts the
   gust into q_ci) on the 15-minute loiter of `driftflights` in its mean wind, 1 m/s
-  turbulence, 10 Hz; the second sensor's q_ci from the true q_c (`Truth.history`).
+  turbulence, 10 Hz; the second sensor's q_ci from the true q_c (`Truth.history`);
+- ``sim_drifting``: the same loiter in `driftflights`' drifting wind (9 m/s from 270° to 11 m/s
+  from 310°), 0.5 m/s turbulence.
 
 Sensor a: k = (0.02, -15) (the simulator's own true k in ``turbulence``), sensor b: (-0.03, 10).
 
@@ -48,16 +50,17 @@ def drifting_flights(seed):
                               wind_drift_mps2=tuple((w1 - w0) / DRIFT_S), turns=8.0)
 
 
-def turbulence_flights(seed):
+def turbulence_flights(seed, turbulence_mps=1.0, drifting=False):
     import dataclasses
 
-    from driftflights import loiter_plan
+    from driftflights import drift_mps2, loiter_plan
 
     from pitotcal.core.models import get_model, qci_from_qc_pa
     from pitotcal.maneuvers.fly.simulator import simulate
 
-    flight, truth = simulate(loiter_plan(), seed=seed, turbulence_mps=1.0, rate_hz=10.0,
-                             gps_noise_mps=0.1, keep_history=True)
+    flight, truth = simulate(loiter_plan(), seed=seed, turbulence_mps=turbulence_mps,
+                             rate_hz=10.0, gps_noise_mps=0.1, keep_history=True,
+                             wind_drift_mps2=drift_mps2() if drifting else (0.0, 0.0))
     qc = np.asarray(truth.history["qc_pa"])
     rng = np.random.default_rng(seed + 7919)
     qci = qci_from_qc_pa(get_model(truth.model), K_B, qc) + rng.standard_normal(qc.size) * 0.5
@@ -66,15 +69,19 @@ def turbulence_flights(seed):
                         "wind_e_mps": truth.wind_e_mps}
 
 
+def sim_drifting_flights(seed):
+    return turbulence_flights(seed, turbulence_mps=0.5, drifting=True)
+
+
 CASES = {"windows": windows_flights, "drifting": drifting_flights,
-         "turbulence": turbulence_flights}
+         "turbulence": turbulence_flights, "sim_drifting": sim_drifting_flights}
 
 
 def scored(case, seed, impl="pitotcal.estimation.identification.multi_sensor"):
     """{z: [k1_a, k2_a, k1_b, k2_b], kind, iv} of one flight (z = error / reported sigma)."""
     fa, fb, truth = CASES[case](seed)
     identify_sensors = importlib.import_module(impl).identify_sensors
-    air = "compressible" if case == "turbulence" else "incompressible"
+    air = "compressible" if case in ("turbulence", "sim_drifting") else "incompressible"
     results = identify_sensors([fa, fb], air=air)
     z, sd = [], []
     for res, k in zip(results, (truth["k_a"], truth["k_b"])):

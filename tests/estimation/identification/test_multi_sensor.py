@@ -104,7 +104,8 @@ def test_two_windows_with_different_winds_keep_each_windows_wind():
 
 
 def test_a_drifting_wind_is_shared_by_the_sensors():
-    """900 s, the wind drifting 3 m/s and 40° (the middle 6 m/s from 280°): the first sensor's
+    """900 s, the wind drifting 2.5 m/s in speed and 40° in direction (4.9 m/s of the vector;
+    6 m/s from 280° in the middle): the first sensor's
     drift is every sensor's, fitted with all their residuals; both calibrations within 2σ."""
     from synthetic import two_sensor_flights, wind_vector
 
