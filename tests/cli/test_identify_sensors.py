@@ -74,6 +74,30 @@ def test_two_ardupilot_sensors_share_the_wind_and_get_a_ratio_each(two, tmp_path
         assert rec["value"] == pytest.approx(2.0 / RHO0_KGM3 / (1.0 - f), rel=0.01)
 
 
+def test_wind_options_act_on_the_joint_fit(two, tmp_path):
+    """`--wind drifting --wind-knot-s 120` on a two-sensor log: both sensors calibrated, the
+    drift shared (the same wind model and track in each), no "first sensor alone" warning."""
+    fa, fb, truth = two
+    log = write_dataflash_bin(tmp_path / "two.bin", fa, second=fb.qci_pa, ratio=1.9,
+                              second_ratio=2.1)
+    rec = tmp_path / "r.json"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(["identify", str(log), "--oat-c", "15", "--no-budget", "--json", str(rec),
+                     "--wind", "drifting", "--wind-knot-s", "120"]) == 0
+    assert not [w for w in caught if "applies to one sensor's fit" in str(w.message)]
+    a, b = json.loads(rec.read_text())["sensors"]
+    for sensor in (a, b):
+        model = sensor["wind_model"]
+        assert (model["kind"], model["knot_s"], model["chosen_by"]) == \
+            ("drifting", 120.0, "option")
+        assert model["shared_by_sensors"] == 2
+    assert a["wind_track"] == b["wind_track"] and len(a["wind_track"]["time_s"]) > 2
+    for sensor, k in ((a, K_A), (b, K_B)):
+        k1 = sensor["parameters"]["k1"]
+        assert abs(k1["value"] - k[0]) < 2.0 * k1["std"]
+
+
 def test_two_px4_sensors_get_a_scale_each(two, tmp_path, capsys):
     fa, fb, _ = two
     log = write_ulog(tmp_path / "two.ulg", fa, second=fb.qci_pa)
