@@ -72,7 +72,8 @@ def add_parser(subparsers):
     p.add_argument("--wind", default="auto", metavar="MODEL",
                    help="wind model: constant, drifting (a wind varying slowly in time, "
                         "piecewise linear between knots) or auto: drifting when a Wald test "
-                        "of no drift rejects it at 1%% (default: auto)")
+                        "of no drift rejects it at 1%% (default: auto); a log with several "
+                        "airspeed sensors: chosen on the first, shared by all")
     p.add_argument("--wind-knot-s", type=float, default=None, metavar="S",
                    help="knot spacing of the drifting wind, s (default: 300 s, or two of the "
                         "flight's orbits when it turns more slowly)")
