@@ -25,11 +25,14 @@ def synthetic_flight(seed=0, n=16000, rate_hz=50.0, model="inverse", k=(0.02, -1
                      wind_speed_mps=5.0, wind_from_deg=270.0, cas_kt=(70.0, 100.0),
                      turns=3.0, turbulence_mps=0.0, turbulence_length_m=300.0,
                      gps_rate_hz=None, gps_noise_mps=0.0, qc_noise_pa=0.3,
-                     quantization_pa=0.0, rho_kgm3=1.196, vertical=False):
+                     quantization_pa=0.0, rho_kgm3=1.196, vertical=False,
+                     wind_drift_mps2=(0.0, 0.0)):
     """Return (Flight, truth); truth = {"model", "parameters": {...}, "k": tuple}.
 
     `turns` is the number of full heading revolutions (0: straight and level, unobservable).
-    Truth wind is the time-average of the wind actually flown through (turbulence included).
+    `wind_drift_mps2` (north, east): the mean wind drifts linearly, the given wind at the
+    record's middle. Truth wind is the time-average of the wind actually flown through
+    (turbulence and drift included).
     """
     rng = np.random.default_rng(seed)
     dt = 1.0 / rate_hz
@@ -49,7 +52,8 @@ def synthetic_flight(seed=0, n=16000, rate_hz=50.0, model="inverse", k=(0.02, -1
         turb[0] = rng.standard_normal(2) * turbulence_mps
         for i in range(1, n):
             turb[i] = a * turb[i - 1] + e[i]
-    wn, we = wn0 + turb[:, 0], we0 + turb[:, 1]
+    wn = wn0 + turb[:, 0] + wind_drift_mps2[0] * (t - 0.5 * t[-1])
+    we = we0 + turb[:, 1] + wind_drift_mps2[1] * (t - 0.5 * t[-1])
     vn = tas * np.cos(psi) + wn
     ve = tas * np.sin(psi) + we
     vd = 0.5 * np.sin(2 * np.pi * t / 30.0) if vertical else None
@@ -166,3 +170,30 @@ def two_sensor_flights(seed=0, k_a=(0.02, -15.0), k_b=(-0.03, 10.0), model="inve
         flights.append(dataclasses.replace(clean, qci_pa=qci,
                                            source=f"synthetic(seed={seed}, sensor {name})"))
     return flights[0], flights[1], {**truth, "k_a": tuple(k_a), "k_b": tuple(k_b)}
+
+
+def two_window_sensor_flights(seed=0, winds=((5.0, 270.0), (8.0, 300.0)), gap_s=600.0, **kw):
+    """Two airspeed sensors over two calibration windows `gap_s` apart (`Flight.segment` 0 and
+    1), each window a `two_sensor_flights` flight with its own constant wind (speed m/s, from
+    deg) and the same calibrations.
+
+    Returns (flight_a, flight_b, truth): truth with "k_a", "k_b", "windows" [(wind_n, wind_e)
+    per window, the average flown through] and the record's mean "wind_n_mps", "wind_e_mps".
+    """
+    parts = [two_sensor_flights(seed=seed + 1000 * i, wind_speed_mps=speed, wind_from_deg=frm,
+                                **kw) for i, (speed, frm) in enumerate(winds)]
+    start = parts[0][0].time_s[-1] + gap_s
+    out = []
+    for j in range(2):
+        one, two = parts[0][j], parts[1][j]
+        fields = {name: np.concatenate([getattr(one, name), getattr(two, name)])
+                  for name in ("qci_pa", "gps_vn_mps", "gps_ve_mps", "rho_kgm3")}
+        out.append(Flight(time_s=np.concatenate([one.time_s, two.time_s + start]), **fields,
+                          segment=np.repeat([0, 1], [one.n, two.n]),
+                          source=f"synthetic(seed={seed}, two windows, sensor {'ab'[j]})"))
+    windows = [(t["wind_n_mps"], t["wind_e_mps"]) for _, _, t in parts]
+    n = [p[0].n for p in parts]
+    mean = np.average(np.array(windows), axis=0, weights=n)
+    return out[0], out[1], {"k_a": parts[0][2]["k_a"], "k_b": parts[0][2]["k_b"],
+                            "windows": windows, "wind_n_mps": float(mean[0]),
+                            "wind_e_mps": float(mean[1])}

@@ -437,7 +437,8 @@ def write_parameter_set(recs, path):
 
 
 def recommend_sensors(flights, autopilot, current, *, air=DEFAULT_AIR_DATA,
-                      misfit_tolerance_kt=None, gps_noise_std_mps=None, path=None):
+                      misfit_tolerance_kt=None, gps_noise_std_mps=None, path=None, wind="auto",
+                      wind_knot_s=None):
     """Each airspeed sensor's parameter from the joint fits of several sensors sharing one
     wind (`estimation.identification.multi_sensor`): the constant, inverse and linear models
     fitted jointly, then `recommend` per sensor on its results.
@@ -451,6 +452,8 @@ def recommend_sensors(flights, autopilot, current, *, air=DEFAULT_AIR_DATA,
         The log's parameters by name (current values: ``ARSPD2_RATIO``, ``ASPD_SCALE_2``...).
     path : str or Path, optional
         Write the recommended ones there as one parameter file (`write_parameter_set`).
+    wind, wind_knot_s
+        The shared wind model of the joint fits (`identify_sensors`).
 
     Returns
     -------
@@ -463,7 +466,8 @@ def recommend_sensors(flights, autopilot, current, *, air=DEFAULT_AIR_DATA,
     for model in ("constant", "inverse", "linear"):
         try:
             fits[model] = identify_sensors(flights, model=model, air=air,
-                                           gps_noise_std_mps=gps_noise_std_mps)
+                                           gps_noise_std_mps=gps_noise_std_mps, wind=wind,
+                                           wind_knot_s=wind_knot_s)
         except ObservabilityError:
             if model == "constant":
                 raise

@@ -63,9 +63,39 @@ def test_two_ardupilot_sensors_share_the_wind_and_get_a_ratio_each(two, tmp_path
     assert "pitotcal: ARSPD2_RATIO" in text
     # the two calibrations differ as the truth does (1.030): the common turbulence cancels
     assert ra["value"] / rb["value"] == pytest.approx(_true_ratio_of_ratios(fa), abs=0.006)
-    # and each is a calibration: 2 / (rho0 (1 - k1)) of its own constant k1
-    assert ra["value"] == pytest.approx(2.0 / RHO0_KGM3 / (1.0 - doc["sensors"][0]
-                                        ["parameters"]["k1"]["value"]), rel=0.03)
+    # and each is a calibration: 2 / (rho0 (1 - f)) of its own fit's f = k1 + k2 / q_ci at
+    # the median q_ci (the record is the inverse model's; the ratio a constant fit's)
+    import numpy as np
+
+    q = float(np.median(fa.qci_pa))
+    for rec, sensor in ((ra, a), (rb, b)):
+        p = sensor["parameters"]
+        f = p["k1"]["value"] + p["k2"]["value"] / q
+        assert rec["value"] == pytest.approx(2.0 / RHO0_KGM3 / (1.0 - f), rel=0.01)
+
+
+def test_wind_options_act_on_the_joint_fit(two, tmp_path):
+    """`--wind drifting --wind-knot-s 120` on a two-sensor log: both sensors calibrated, the
+    drift shared (the same wind model and track in each), no "first sensor alone" warning."""
+    fa, fb, truth = two
+    log = write_dataflash_bin(tmp_path / "two.bin", fa, second=fb.qci_pa, ratio=1.9,
+                              second_ratio=2.1)
+    rec = tmp_path / "r.json"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert main(["identify", str(log), "--oat-c", "15", "--no-budget", "--json", str(rec),
+                     "--wind", "drifting", "--wind-knot-s", "120"]) == 0
+    assert not [w for w in caught if "applies to one sensor's fit" in str(w.message)]
+    a, b = json.loads(rec.read_text())["sensors"]
+    for sensor in (a, b):
+        model = sensor["wind_model"]
+        assert (model["kind"], model["knot_s"], model["chosen_by"]) == \
+            ("drifting", 120.0, "option")
+        assert model["shared_by_sensors"] == 2
+    assert a["wind_track"] == b["wind_track"] and len(a["wind_track"]["time_s"]) > 2
+    for sensor, k in ((a, K_A), (b, K_B)):
+        k1 = sensor["parameters"]["k1"]
+        assert abs(k1["value"] - k[0]) < 2.0 * k1["std"]
 
 
 def test_two_px4_sensors_get_a_scale_each(two, tmp_path, capsys):

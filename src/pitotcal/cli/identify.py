@@ -72,7 +72,8 @@ def add_parser(subparsers):
     p.add_argument("--wind", default="auto", metavar="MODEL",
                    help="wind model: constant, drifting (a wind varying slowly in time, "
                         "piecewise linear between knots) or auto: drifting when a Wald test "
-                        "of no drift rejects it at 1%% (default: auto)")
+                        "of no drift rejects it at 1%% (default: auto); a log with several "
+                        "airspeed sensors: chosen on the first, shared by all")
     p.add_argument("--wind-knot-s", type=float, default=None, metavar="S",
                    help="knot spacing of the drifting wind, s (default: 300 s, or two of the "
                         "flight's orbits when it turns more slowly)")
@@ -265,11 +266,11 @@ def _identify_all(args, source, sensors, inputs):
     flight, autopilot, current = _read(args, source)
     arm_m = sensors[0].get("probe_arm_m", 0.0)
     flights = [flight, *other_sensor_flights(source, flight, csv_columns=args.columns, single_only={
-        "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m,
-        "--wind drifting": args.wind == "drifting", "--wind-knot-s": args.wind_knot_s})]
+        "--gps-error-sigma-mps": args.gps_error_sigma_mps, "--probe-arm-m": arm_m})]
     fit = ([with_hides_threshold(r, hides_threshold(args.hides_threshold_kt)) for r in
             identify_sensors(flights, model=args.model, air=args.air, budget=inputs,
-                             gps_noise_std_mps=args.gps_noise_mps)] if len(flights) > 1 else
+                             gps_noise_std_mps=args.gps_noise_mps, wind=args.wind,
+                             wind_knot_s=args.wind_knot_s)] if len(flights) > 1 else
            [identify(flight, model=args.model, air=args.air, budget=inputs, probe_arm_m=arm_m,
                      gps_noise_std_mps=args.gps_noise_mps, wind=args.wind,
                      wind_knot_s=args.wind_knot_s, hides_threshold_kt=args.hides_threshold_kt,
@@ -286,7 +287,8 @@ def _recommend(args, flights, result, sensors, autopilot, current):
     if len(flights) > 1:
         per = recommend_sensors(flights, autopilot, current, air=args.air, path=args.params,
                                 misfit_tolerance_kt=args.misfit_tolerance_kt,
-                                gps_noise_std_mps=args.gps_noise_mps)
+                                gps_noise_std_mps=args.gps_noise_mps, wind=args.wind,
+                                wind_knot_s=args.wind_knot_s)
         return per[0][0], next((exc for _, exc in per if exc is not None), None), per
     flight, arm_m = flights[0], sensors[0].get("probe_arm_m", 0.0)
     if arm_m:           # the recommendation refits: the data corrected as the result was

@@ -52,21 +52,75 @@ def test_sensors_on_shifted_time_bases(two):
     assert np.isfinite(ra.covariance).all()
 
 
-def test_windows_keep_one_shared_constant_wind_in_the_record(two):
-    """Two calibration windows (`Flight.segment`): each sensor's own fit keeps a wind per
-    window, the joint fit one wind; the record says the joint fit's wind, with no drift for
-    the budget to take out of the flight."""
+def test_windows_share_the_first_sensors_wind_model_in_the_record(two):
+    """Two calibration windows (`Flight.segment`) of one wind: the first sensor's wind model
+    (a wind per window, or a drift in each) is every sensor's, with its drift for the budget
+    to take out of the flight, and the mean wind within its bounds."""
     import dataclasses
 
     fa, fb, truth = two
     fa, fb = (dataclasses.replace(f, segment=(f.time_s > 300.0).astype(int)) for f in (fa, fb))
-    assert identify(fa, air="incompressible", budget=None).wind_model["kind"] != "constant"
-    for res in identify_sensors([fa, fb], air="incompressible"):
-        assert res.drift is None and res.wind_model["kind"] == "constant"
-        assert res.wind_model["test"] is None
-        assert res.wind_track["speed_mps"] == [res.value("wind_speed_mps")] * 2
+    alone = identify(fa, air="incompressible", budget=None)
+    assert alone.wind_model["kind"] != "constant"
+    results = identify_sensors([fa, fb], air="incompressible")
+    for res in results:
+        assert res.drift is not None and res.wind_model["kind"] == alone.wind_model["kind"]
+        assert res.wind_model["shared_by_sensors"] == 2
+        assert res.wind_track["segment"][0] == 0 and res.wind_track["segment"][-1] == 1
         assert abs(res.value("wind_speed_mps") - truth["parameters"]["wind_speed_mps"]) \
             < 2.0 * res.stddev("wind_speed_mps")
+    assert np.array_equal(results[0].drift[1], results[1].drift[1])
+    assert results[0].wind_track == results[1].wind_track
+
+
+def _window_winds(res):
+    """The wind (north, east) of each window of the result's track, at its middle point."""
+    track = res.wind_track
+    seg = np.asarray(track["segment"])
+    out = []
+    for s in (0, 1):
+        i = np.flatnonzero(seg == s)[len(np.flatnonzero(seg == s)) // 2]
+        speed, frm = track["speed_mps"][i], np.radians(track["from_deg"][i])
+        out.append((-speed * np.cos(frm), -speed * np.sin(frm), track["speed_2sigma_mps"][i]))
+    return out
+
+
+def test_two_windows_with_different_winds_keep_each_windows_wind():
+    """Two windows 600 s apart, 5 m/s from 270° and 8 m/s from 300°, two sensors in 0.3 m/s
+    turbulence: both calibrations within 2σ, each window's wind recovered within its 2σ (a
+    single wind for both windows cannot: they are 4.4 m/s apart)."""
+    from synthetic import two_window_sensor_flights
+
+    fa, fb, truth = two_window_sensor_flights(seed=2, n=3000, rate_hz=10.0,
+                                              turbulence_mps=0.3)
+    results = identify_sensors([fa, fb], air="incompressible", wind="constant")
+    for res, k in zip(results, (truth["k_a"], truth["k_b"])):
+        assert res.converged and res.wind_model["kind"] == "constant per window"
+        for name, true in zip(("k1", "k2"), k):
+            assert abs(res.value(name) - true) < 2.0 * res.stddev(name), name
+        for (wn, we, two_sigma), (tn, te) in zip(_window_winds(res), truth["windows"]):
+            assert np.hypot(wn - tn, we - te) < max(two_sigma, 0.1)
+    assert "one shared wind model (constant per window)" in results[1].warnings[-1]
+
+
+def test_a_drifting_wind_is_shared_by_the_sensors():
+    """900 s, the wind drifting 2.5 m/s in speed and 40° in direction (4.9 m/s of the vector;
+    6 m/s from 280° in the middle): the first sensor's
+    drift is every sensor's, fitted with all their residuals; both calibrations within 2σ."""
+    from synthetic import two_sensor_flights, wind_vector
+
+    w0, w1 = np.array(wind_vector(5.0, 260.0)), np.array(wind_vector(7.5, 300.0))
+    fa, fb, truth = two_sensor_flights(seed=4, n=9000, rate_hz=10.0, turbulence_mps=0.3,
+                                       wind_speed_mps=6.0, wind_from_deg=280.0,
+                                       wind_drift_mps2=tuple((w1 - w0) / 900.0), turns=8.0)
+    results = identify_sensors([fa, fb], air="incompressible", wind="drifting")
+    for res, k in zip(results, (truth["k_a"], truth["k_b"])):
+        assert res.converged and res.wind_model["kind"] == "drifting"
+        assert res.drift is not None and res.wind_model["chosen_by"] == "option"
+        for name, true in zip(("k1", "k2"), k):
+            assert abs(res.value(name) - true) < 2.0 * res.stddev(name), name
+        speed = np.asarray(res.wind_track["speed_mps"])
+        assert speed[-1] - speed[0] > 1.5          # the drift is in the track
 
 
 def coverage(n_flights, **flight_kw):
