@@ -24,6 +24,7 @@ from . import compliance as comp
 from .aircraft_file import AIRCRAFT_FIELDS, aircraft_rule, read_aircraft
 from .budget_tables import budget_report
 from .conditions import turbulence_text
+from .refit import refit, reproduces
 
 __all__ = ["AIRCRAFT_FIELDS", "build_report", "make_report", "read_aircraft", "read_result",
            "render_html", "sha256", "write_pdf"]
@@ -92,7 +93,7 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
         figures.append(("Altimeter correction", _png(alt)))
     if ident is not None and flight is not None:
         if "points" not in result:      # a legs result is another method: not comparable
-            warnings += _reproduces(result, ident)
+            warnings += reproduces(result, ident)
         figures.append(("Calibration (paper Figs. 7-8 style), with the residual time history",
                         _png(figs.calibration_png(ident, result))))
         figures.append(("Ground track and residual distribution", _png(figs.track_png(flight,
@@ -115,33 +116,6 @@ def build_report(result, *, flight=None, aircraft_rows=(), regulation="23.1323",
                        "inputs": [(role, str(p), sha256(p)) for role, p in inputs]},
         "fmt": _fmt,
     }
-
-
-def _wind_options(result):
-    """identify's `wind` and `wind_knot_s` that refit the result's wind model: a drifting wind
-    with its knots; a constant wind (one per window with several) as it was; {} for a record
-    without a wind model (the default, as identify had then)."""
-    kind = (result.get("wind_model") or {}).get("kind")
-    if kind == "drifting":
-        return {"wind": "drifting", "wind_knot_s": result["wind_model"].get("knot_s")}
-    return {"wind": "constant"} if kind in ("constant", "constant per window") else {}
-
-
-def _reproduces(result, ident):
-    """A warning when the fit re-run on the given flight is not the result's."""
-    out = []
-    for name, entry in (result.get("parameters") or {}).items():
-        if name not in ident.param_names or not isinstance(entry, dict):
-            continue
-        value, std = entry.get("value"), entry.get("std")
-        if value is None or not std:
-            continue
-        if abs(ident.value(name) - value) > 0.1 * std:
-            out.append(f"the flight given does not reproduce the result ({name} "
-                       f"{ident.value(name):.5g} vs {value:.5g}): the figures of the fit are "
-                       "of the flight as read, check window, OAT and file")
-            break
-    return out
 
 
 def _param(result, name, scale=1.0):
@@ -318,7 +292,6 @@ def read_result(path):
 
 
 # the reading a result records that `read_flight` takes (its "oat_source" is a description)
-_READING_OPTIONS = ("start_s", "end_s", "oat_k", "temp_recovery", "rh_pct", "oat_ground_k")
 
 def make_report(result_path, html_path, *, flight_path=None, flight_options=None,
                 aircraft_path=None,
@@ -343,25 +316,7 @@ def make_report(result_path, html_path, *, flight_path=None, flight_options=None
     inputs = [("Result JSON", result_path)]
     flight = ident = None
     if flight_path is not None:
-        from pitotcal.io import read_flight
-
-        from ..identification.identify import identify
-
-        # what identify recorded ("reading"), overridden by what the report was told
-        opts = {k: v for src in (result.get("reading") or {}, flight_options or {})
-                for k, v in src.items() if v is not None and k in _READING_OPTIONS}
-        if result.get("windows") and opts.get("start_s") is None and opts.get("end_s") is None:
-            opts["windows"] = "auto"        # the windows identify chose from the log, again
-        # the same reading and air data, then identify's air-data mode: the same fit
-        flight = read_flight(flight_path, **opts)
-        stated = result.get("gps_error") or {}
-        ident = identify(flight, model=result.get("model", "inverse"),
-                         air=result.get("air_data", "incompressible"),
-                         gps_noise_std_mps=result.get("gps_noise_std_mps"),
-                         gps_error_sigma_mps=stated.get("sigma_mps"),
-                         gps_error_tau_s=stated.get("tau_s"),
-                         probe_arm_m=(result.get("reading") or {}).get("probe_arm_m") or 0.0,
-                         **_wind_options(result))
+        flight, ident = refit(result, flight_path, flight_options)
         inputs.append(("Flight", flight_path))
     rows, rule = (), {"configuration": None, "speeds_kcas": {}}
     if aircraft_path is not None:

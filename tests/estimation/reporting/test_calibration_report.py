@@ -91,7 +91,7 @@ def test_read_result_refuses_other_files(tmp_path):
 
 def test_a_flight_that_does_not_reproduce_the_result_is_a_warning():
     from pitotcal.estimation import identify
-    from pitotcal.estimation.reporting.calibration_report import _reproduces
+    from pitotcal.estimation.reporting.refit import reproduces as _reproduces
     from synthetic import synthetic_flight
 
     ident = identify(synthetic_flight(seed=7, n=1500)[0])
