@@ -4,6 +4,7 @@ every error case."""
 
 import logging
 import shutil
+import warnings
 
 import numpy as np
 import pytest
@@ -88,6 +89,39 @@ def test_corrupt_bytes_skipped_are_warned_and_recorded(tmp_path, truth_flight):
     with pytest.warns(UserWarning, match=r"flight\.bin: skipped 100 corrupt bytes in the log"):
         flight = read_log(path, oat_k=288.0)
     assert flight.warnings == ("flight.bin: skipped 100 corrupt bytes in the log",)
+
+
+def test_mangled_binary_logs_are_refused_in_one_line(tmp_path, truth_flight):
+    """A DataFlash binary whose format record names a type pymavlink does not know (it raises a
+    bare Exception, "Unsupported format char") and seeded random damage: each copy reads or is
+    refused with a FlightDataError naming the file, never a traceback; inputs unchanged."""
+    import random
+
+    from pitotcal.core.errors import FlightDataError
+
+    data = _write("dataflash-bin", tmp_path, truth_flight[0]).read_bytes()
+    fmt = data.index(b"\xa3\x95\x80", 3)     # the second FMT record (the first is FMT's own)
+    bad = bytearray(data)
+    bad[fmt + 9:fmt + 11] = b"Qy"                # its format string: 'y' is no DataFlash type
+    copies = {"badfmt.bin": bytes(bad)}
+    rng = random.Random(0)
+    for trial in range(12):
+        b = bytearray(data)
+        for _ in range(rng.choice([1, 5, 50])):
+            b[rng.randrange(len(b))] = rng.randrange(256)
+        copies[f"m{trial}.bin"] = bytes(b[:rng.randrange(len(b))] if trial % 3 == 0 else b)
+    for name, content in copies.items():
+        path = tmp_path / name
+        path.write_bytes(content)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            try:
+                read_log(path, oat_k=288.0)
+            except FlightDataError as exc:
+                assert str(exc).startswith(f"{name}: "), exc
+            else:
+                assert name != "badfmt.bin"
+        assert path.read_bytes() == content
 
 
 def test_airspeed_without_pressure_uses_ratio(tmp_path, truth_flight):

@@ -5,7 +5,6 @@ import contextlib
 import io
 import os
 import re
-import struct
 import sys
 import tempfile
 import warnings
@@ -18,9 +17,11 @@ __all__ = ["LOG_EXTENSIONS", "MAVLINK_READ_ERRORS", "LogStreams", "captured_outp
 
 # The autopilot log formats pitotcal reads (anything else is read as a flight CSV).
 LOG_EXTENSIONS = (".ulg", ".bin", ".log", ".tlog")
-# What pymavlink raises on an empty, truncated or mangled file (its parsers fail low down)
-MAVLINK_READ_ERRORS = (ValueError, OSError, IndexError, KeyError, TypeError, UnicodeDecodeError,
-                       AttributeError, struct.error)
+# What pymavlink raises on an empty, truncated or mangled file: its parsers fail low down
+# (ValueError, IndexError, struct.error, ...) and its DataFlash reader raises a bare Exception
+# for a mangled FMT record ("Unsupported format char"), so every Exception; a reader re-raises
+# its own FlightDataError before this
+MAVLINK_READ_ERRORS = (Exception,)
 
 
 def skipped_bytes(chatter):
