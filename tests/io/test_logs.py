@@ -124,6 +124,22 @@ def test_mangled_binary_logs_are_refused_in_one_line(tmp_path, truth_flight):
         assert path.read_bytes() == content
 
 
+def test_ulog_topic_without_its_timestamp_is_refused_in_one_line(tmp_path, truth_flight):
+    """A ULog whose format definition of differential_pressure lost its timestamp field (a
+    mangled header): refused naming the file and the field, never a KeyError traceback."""
+    from pitotcal.core.errors import FlightDataError
+
+    data = _write("ulog-newer", tmp_path, truth_flight[0]).read_bytes()
+    at = data.index(b"timestamp", data.index(b"differential_pressure:"))
+    path = tmp_path / "badfield.ulg"
+    path.write_bytes(data[:at] + b"timestxmp" + data[at + 9:])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(FlightDataError, match=r"^badfield\.ulg: a logged topic lacks the "
+                                                  r"field 'timestamp'"):
+            read_log(path, oat_k=288.0)
+
+
 def test_airspeed_without_pressure_uses_ratio(tmp_path, truth_flight):
     flight, _ = truth_flight
     path = _write("dataflash-text-old", tmp_path, flight, airspeed_only=True)

@@ -94,12 +94,16 @@ def read_ulog_streams(path):
     if not ulog.data_list:
         raise FlightDataError(f"{name}: no logged data after the ULog header; truncated or "
                               "corrupt file?")
-    _read_pressure(ulog, t0, s, name)
-    _read_static_and_temperature(ulog, t0, s)
-    _read_gps(ulog, t0, s)
-    _read_flight_state(ulog, t0, s)
-    _read_autopilot_estimates(ulog, t0, s)
-    _read_throttle(ulog, t0, s)
+    try:
+        _read_pressure(ulog, t0, s, name)
+        _read_static_and_temperature(ulog, t0, s)
+        _read_gps(ulog, t0, s)
+        _read_flight_state(ulog, t0, s)
+        _read_autopilot_estimates(ulog, t0, s)
+        _read_throttle(ulog, t0, s)
+    except KeyError as exc:     # a mangled format definition: a topic without its fields
+        raise FlightDataError(f"{name}: a logged topic lacks the field {exc}; corrupt format "
+                              "definitions in the ULog header?") from None
     return s
 
 
