@@ -91,25 +91,32 @@ def test_corrupt_bytes_skipped_are_warned_and_recorded(tmp_path, truth_flight):
     assert flight.warnings == ("flight.bin: skipped 100 corrupt bytes in the log",)
 
 
-def test_mangled_binary_logs_are_refused_in_one_line(tmp_path, truth_flight):
+def test_mangled_binary_logs_are_refused_in_one_line(tmp_path):
     """A DataFlash binary whose format record names a type pymavlink does not know (it raises a
-    bare Exception, "Unsupported format char") and seeded random damage: each copy reads or is
-    refused with a FlightDataError naming the file, never a traceback; inputs unchanged."""
+    bare Exception, "Unsupported format char"), and seeded random damage (bytes changed, the
+    file cut): each copy reads or is refused with a FlightDataError naming the file, never a
+    traceback; inputs unchanged. The damaged copies read here are those of the seeded
+    sequence that once escaped (an empty stream after cleaning, a static stream of NaN, a
+    message without a column its FMT record named)."""
     import random
 
     from pitotcal.core.errors import FlightDataError
 
-    data = _write("dataflash-bin", tmp_path, truth_flight[0]).read_bytes()
+    flight, _ = synthetic_flight(seed=1, n=1500, rate_hz=10.0)
+    data = write_dataflash_bin(tmp_path / "base.bin", flight).read_bytes()
     fmt = data.index(b"\xa3\x95\x80", 3)     # the second FMT record (the first is FMT's own)
     bad = bytearray(data)
     bad[fmt + 9:fmt + 11] = b"Qy"                # its format string: 'y' is no DataFlash type
     copies = {"badfmt.bin": bytes(bad)}
-    rng = random.Random(0)
-    for trial in range(12):
+    rng = random.Random(7)
+    for trial in range(172):
         b = bytearray(data)
-        for _ in range(rng.choice([1, 5, 50])):
+        for _ in range(rng.choice([1, 3, 10, 50, 200])):
             b[rng.randrange(len(b))] = rng.randrange(256)
-        copies[f"m{trial}.bin"] = bytes(b[:rng.randrange(len(b))] if trial % 3 == 0 else b)
+        if trial % 4 == 0:
+            b = b[:rng.randrange(len(b))]
+        if trial in (7, 42, 48, 69, 101, 113, 171):
+            copies[f"m{trial}.bin"] = bytes(b)
     for name, content in copies.items():
         path = tmp_path / name
         path.write_bytes(content)
@@ -122,6 +129,13 @@ def test_mangled_binary_logs_are_refused_in_one_line(tmp_path, truth_flight):
             else:
                 assert name != "badfmt.bin"
         assert path.read_bytes() == content
+
+
+def test_clean_of_a_stream_with_no_finite_sample_is_empty():
+    from pitotcal.io.timebase import clean
+
+    t, x = clean(np.array([np.nan, 1.0]), np.array([2.0, np.nan]))
+    assert t.size == 0 and x.size == 0
 
 
 def test_ulog_topic_without_its_timestamp_is_refused_in_one_line(tmp_path, truth_flight):

@@ -165,15 +165,19 @@ def read_dataflash_streams(path):
     if skipped:
         s.warn(f"{name}: skipped {skipped} corrupt bytes in the log", stacklevel=4)
     s.autopilot = firmware or "ArduPilot (firmware version not logged)"
-    arsp = _read_pressure(data, params, t0, s, name)
-    _read_other_sensors(data, t0, s)
-    _read_static_and_temperature(data, arsp, t0, s)
-    _read_gps(data, t0, s)
-    _read_flight_state(data, params, t0, s)
-    _read_oat_and_throttle(data, t0, s)
+    try:
+        arsp = _read_pressure(data, params, t0, s, name)
+        _read_other_sensors(data, t0, s)
+        _read_static_and_temperature(data, arsp, t0, s)
+        _read_gps(data, t0, s)
+        _read_flight_state(data, params, t0, s)
+        _read_oat_and_throttle(data, t0, s)
+    except KeyError as exc:     # a mangled FMT record: a message without its columns
+        raise FlightDataError(f"{name}: a logged message lacks the column {exc}; corrupt "
+                              "format (FMT) records?") from None
     for wtype in ("XKF2", "NKF2", "EKF2"):
         wind = data.get(wtype)
-        if wind is not None and wind["t"].size and "VWN" in wind:
+        if wind is not None and wind["t"].size and "VWN" in wind and "VWE" in wind:
             wind = _instance0(wind, "C")
             s.wind_t, s.wind_n, s.wind_e = wind["t"] - t0, wind["VWN"], wind["VWE"]
             s.wind_source = f"{wtype}.VWN/VWE (EKF)"

@@ -355,9 +355,10 @@ def _density(s, t, q, alt, opt):
 
     Records every substitution in `s.conversions` (warned later).
     """
-    static_ok = None
-    if s.ps_pa is not None and s.static_t is not None and s.static_t.size >= 2:
+    static_ok, ts = None, np.empty(0)
+    if s.ps_pa is not None and s.static_t is not None:
         ts, ps_s = clean(np.asarray(s.static_t, float), np.asarray(s.ps_pa, float))
+    if ts.size >= 2:            # finite samples to interpolate between
         ps = np.interp(t, ts, ps_s)
         static_ok = (t >= ts[0] - _SLOW_HOLD_S) & (t <= ts[-1] + _SLOW_HOLD_S)
     else:

@@ -28,7 +28,8 @@ def clean(t, *arrays):
     order = np.argsort(t, kind="stable")
     t = t[order]
     arrays = [a[order] for a in arrays]
-    first = np.r_[True, np.diff(t) > 0]
+    first = np.ones(t.size, dtype=bool)
+    first[1:] = np.diff(t) > 0
     return (t[first], *[a[first] for a in arrays])
 
 
