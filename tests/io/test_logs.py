@@ -131,6 +131,34 @@ def test_mangled_binary_logs_are_refused_in_one_line(tmp_path):
         assert path.read_bytes() == content
 
 
+def test_mangled_ulog_version_is_no_version(tmp_path):
+    """A seeded damaged ULog whose header's ver_sw_release no longer parses as a number
+    (pyulog raised TypeError on it): the log reads, with no firmware version, and the
+    calibration refuses what the damage left (a one-line error, never a traceback)."""
+    import random
+
+    from pitotcal.core.errors import PitotcalError
+    from pitotcal.estimation import identify
+
+    flight, _ = synthetic_flight(seed=1, n=1500, rate_hz=10.0)
+    data = write_ulog(tmp_path / "base.ulg", flight).read_bytes()
+    rng = random.Random(11)
+    for trial in range(73):
+        b = bytearray(data)
+        for _ in range(rng.choice([1, 3, 10, 50, 200])):
+            b[rng.randrange(len(b))] = rng.randrange(256)
+        if trial % 4 == 0:
+            b = b[:rng.randrange(len(b))]
+    path = tmp_path / "m72.ulg"
+    path.write_bytes(bytes(b))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            identify(read_log(path, oat_k=288.0))
+        except PitotcalError as exc:
+            assert str(exc).startswith("m72.ulg: "), exc
+
+
 def test_clean_of_a_stream_with_no_finite_sample_is_empty():
     from pitotcal.io.timebase import clean
 

@@ -84,7 +84,11 @@ def read_ulog_streams(path):
     s = LogStreams(log_format="PX4 ULog")
     t0 = ulog.start_timestamp
     info = ulog.msg_info_dict
-    s.autopilot = f"{info.get('sys_name', 'PX4')} {ulog.get_version_info_str() or ''}".strip()
+    try:
+        version = ulog.get_version_info_str() or ""
+    except (TypeError, ValueError):     # a mangled ver_sw_release in the header: no version
+        version = ""
+    s.autopilot = f"{info.get('sys_name', 'PX4')} {version}".strip()
     if info.get("ver_sw_branch"):
         s.autopilot += f" ({info['ver_sw_branch']})"
     if getattr(ulog, "file_corruption", False):
