@@ -91,6 +91,19 @@ def test_corrupt_bytes_skipped_are_warned_and_recorded(tmp_path, truth_flight):
     assert flight.warnings == ("flight.bin: skipped 100 corrupt bytes in the log",)
 
 
+def _damaged(data, seed, n):
+    """`n` seeded damaged copies of `data`: 1-200 bytes changed at random, every fourth cut
+    at a random length (the sequence the fuzzing that found the readers' escapes used)."""
+    import random
+
+    rng = random.Random(seed)
+    for trial in range(n):
+        b = bytearray(data)
+        for _ in range(rng.choice([1, 3, 10, 50, 200])):
+            b[rng.randrange(len(b))] = rng.randrange(256)
+        yield bytes(b[:rng.randrange(len(b))] if trial % 4 == 0 else b)
+
+
 def test_mangled_binary_logs_are_refused_in_one_line(tmp_path):
     """A DataFlash binary whose format record names a type pymavlink does not know (it raises a
     bare Exception, "Unsupported format char"), and seeded random damage (bytes changed, the
@@ -98,8 +111,6 @@ def test_mangled_binary_logs_are_refused_in_one_line(tmp_path):
     traceback; inputs unchanged. The damaged copies read here are those of the seeded
     sequence that once escaped (an empty stream after cleaning, a static stream of NaN, a
     message without a column its FMT record named)."""
-    import random
-
     from pitotcal.core.errors import FlightDataError
 
     flight, _ = synthetic_flight(seed=1, n=1500, rate_hz=10.0)
@@ -108,15 +119,9 @@ def test_mangled_binary_logs_are_refused_in_one_line(tmp_path):
     bad = bytearray(data)
     bad[fmt + 9:fmt + 11] = b"Qy"                # its format string: 'y' is no DataFlash type
     copies = {"badfmt.bin": bytes(bad)}
-    rng = random.Random(7)
-    for trial in range(172):
-        b = bytearray(data)
-        for _ in range(rng.choice([1, 3, 10, 50, 200])):
-            b[rng.randrange(len(b))] = rng.randrange(256)
-        if trial % 4 == 0:
-            b = b[:rng.randrange(len(b))]
+    for trial, b in enumerate(_damaged(data, seed=7, n=172)):
         if trial in (7, 42, 48, 69, 101, 113, 171):
-            copies[f"m{trial}.bin"] = bytes(b)
+            copies[f"m{trial}.bin"] = b
     for name, content in copies.items():
         path = tmp_path / name
         path.write_bytes(content)
@@ -135,22 +140,13 @@ def test_mangled_ulog_version_is_no_version(tmp_path):
     """A seeded damaged ULog whose header's ver_sw_release no longer parses as a number
     (pyulog raised TypeError on it): the log reads, with no firmware version, and the
     calibration refuses what the damage left (a one-line error, never a traceback)."""
-    import random
-
     from pitotcal.core.errors import PitotcalError
     from pitotcal.estimation import identify
 
     flight, _ = synthetic_flight(seed=1, n=1500, rate_hz=10.0)
     data = write_ulog(tmp_path / "base.ulg", flight).read_bytes()
-    rng = random.Random(11)
-    for trial in range(73):
-        b = bytearray(data)
-        for _ in range(rng.choice([1, 3, 10, 50, 200])):
-            b[rng.randrange(len(b))] = rng.randrange(256)
-        if trial % 4 == 0:
-            b = b[:rng.randrange(len(b))]
     path = tmp_path / "m72.ulg"
-    path.write_bytes(bytes(b))
+    path.write_bytes(list(_damaged(data, seed=11, n=73))[72])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
