@@ -20,10 +20,13 @@ from pitotcal.core.models import qc_from_qci_pa
 from .residual import ratio_columns, residual, residual_terms, sensitivities, spread_weights
 from .unknowns import COEFS, WIND_E, WIND_N, theta_scales
 
-__all__ = ["IV_NOT_CONVERGED", "IV_WINDOW_S", "equation_values", "estimating_equations",
-           "instruments", "iv_refine", "smooth_in_time", "window_bounds"]
+__all__ = ["IV_NOT_CONVERGED", "IV_TOL", "IV_WINDOW_S", "equation_values", "estimating_equations",
+           "instruments", "iv_refine", "smooth_in_time", "spread_gradient", "window_bounds"]
 
 IV_WINDOW_S = 20.0
+# Newton steps have converged when every unknown moves less than this in its scale (as IPOPT's
+# tol: far below any sigma)
+IV_TOL = 1e-6
 # The start of the warning a result carries when the refinement did not converge
 IV_NOT_CONVERGED = "instrumental-variable refinement did not converge"
 
@@ -63,11 +66,19 @@ def estimating_equations(model, theta, channels, q_smooth):
     s = sensitivities(model, theta, *ch.args)
     z = instruments(model, theta, q_smooth, s)
     g = z.T @ r
-    # the wind rows: the gradient of the objective's GPS-noise spread term
-    c, w = spread_weights(model, theta, ch)
-    g[WIND_N] += c * float(np.sum(w * (ch.vn - theta[WIND_N])))
-    g[WIND_E] += c * float(np.sum(w * (ch.ve - theta[WIND_E])))
+    en, ee = spread_gradient(model, theta, ch)
+    g[WIND_N] += float(np.sum(en))
+    g[WIND_E] += float(np.sum(ee))
     return g, z, s
+
+
+def spread_gradient(model, theta, channels):
+    """Per sample, the wind rows' (north, east) terms of the estimating equations from the
+    objective's GPS-noise spread term (`residual.spread_weights`): their sums are its
+    gradient."""
+    ch = channels
+    c, w = spread_weights(model, theta, ch)
+    return c * w * (ch.vn - theta[WIND_N]), c * w * (ch.ve - theta[WIND_E])
 
 
 def equation_values(model, theta, channels, q_smooth):
@@ -123,7 +134,7 @@ def iv_refine(model, theta, channels, q_smooth, max_iter=10):
         if not np.all(np.isfinite(step)):
             return theta, None, None
         th = th - step
-        if np.max(np.abs(step / scales)) < 1e-6:       # as IPOPT tol: far below any sigma
+        if np.max(np.abs(step / scales)) < IV_TOL:
             s = sensitivities(model, th, *ch.args)
             return th, instruments(model, th, q_smooth, s), s
     return theta, None, None

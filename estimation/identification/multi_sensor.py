@@ -65,14 +65,13 @@ from .multi_sensor_wind import (
     joint_iv,
     sensor_terms,
     shared_drift,
-    shifted,
     smoothed_qci,
     x_scales,
 )
 from .oe import DEFAULT_IPOPT_OPTIONS, objective_function, objective_inputs
 from .residual import flight_channels
 from .unknowns import WIND_NAMES, to_reported
-from .wind_drift import check_wind_options, constant_wind, wind_track, without_drift
+from .wind_drift import check_wind_options, constant_wind, shifted, wind_track, without_drift
 
 __all__ = ["identify_sensors", "joint_note", "sensors_record", "sensors_summary"]
 

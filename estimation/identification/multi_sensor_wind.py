@@ -5,7 +5,7 @@ wind_e] (`multi_sensor`) and d the drift of the first sensor's chosen wind basis
 (`wind_drift.DriftBasis`: drift knots and/or one wind per calibration window; empty for a
 constant wind), north values then east. Every sensor sees W(t) = W_mean + B(t) d at its own
 sample times, so a sensor's residual depends on its own coefficients, the mean wind and d; its
-sensitivities to d are its wind columns times B (as `wind_drift._whole_jacobian`).
+sensitivities to d are its wind columns times B (`wind_drift.drift_columns`).
 
 `joint_gauss_newton` estimates (theta, d) from all sensors' residuals, each weighted by its
 noise 1 / sigma_s; `joint_iv` solves the estimating equations of the whole problem: each
@@ -15,23 +15,18 @@ sensors' corrected scores (the objective's GPS-noise spread term included, its d
 wind rows times B).
 """
 
-import dataclasses
-
 import numpy as np
 
-from .iv import IV_WINDOW_S, instruments, smooth_in_time
-from .residual import residual, sensitivities, spread_weights
+from .iv import IV_TOL, IV_WINDOW_S, instruments, smooth_in_time, spread_gradient
+from .residual import residual, sensitivities
 from .unknowns import theta_scales
+from .wind_drift import GN_WIND_TOL_MPS, drift_columns, gauss_newton_step, shifted
 
-__all__ = ["joint_gauss_newton", "joint_iv", "sensor_terms", "shared_drift", "shifted",
-           "smoothed_qci", "x_scales"]
+__all__ = ["joint_gauss_newton", "joint_iv", "sensor_terms", "shared_drift", "smoothed_qci",
+           "x_scales"]
 
 _GN_ITERATIONS = 8
 _IV_ITERATIONS = 10
-# Convergence of the joint Gauss-Newton: the wind (mean and drift) settled to this, m/s
-_GN_WIND_TOL_MPS = 1e-4
-# Convergence of the instrumental-variable Newton steps, in the scaled unknowns (IPOPT's tol)
-_IV_TOL = 1e-6
 
 
 def shared_drift(result):
@@ -41,14 +36,6 @@ def shared_drift(result):
         return None, np.zeros(0)
     basis, d = result.drift
     return basis, np.asarray(d, dtype=float)
-
-
-def shifted(ch, b, d):
-    """Channels `ch` with the drift B d taken out of the GPS velocity (north, east)."""
-    m = b.shape[1]
-    if m == 0:
-        return ch
-    return dataclasses.replace(ch, vn=ch.vn - b @ d[:m], ve=ch.ve - b @ d[m:])
 
 
 def smoothed_qci(parts):
@@ -76,8 +63,7 @@ def sensor_terms(part, sl, x, n_theta, q_smooth=None):
         out = np.zeros((r.size, x.size))
         out[:, sl] = cols[:, :-2]
         out[:, n_theta - 2:n_theta] = cols[:, -2:]
-        out[:, n_theta:n_theta + m] = cols[:, [-2]] * part.b
-        out[:, n_theta + m:] = cols[:, [-1]] * part.b
+        out[:, n_theta:] = drift_columns(cols, part.b)
         return out
 
     s = embed(s_own)
@@ -96,14 +82,11 @@ def joint_gauss_newton(parts, slices, x, n_theta):
             w = 1.0 / np.sqrt(p.sigma2)
             rows.append(s * w)
             res.append(r * w)
-        jac, r = np.vstack(rows), np.concatenate(res)
-        scale = np.sqrt(np.mean(jac ** 2, axis=0))
-        scale[scale == 0] = 1.0
-        step = np.linalg.lstsq(jac / scale, -r, rcond=None)[0] / scale
+        step = gauss_newton_step(np.vstack(rows), np.concatenate(res))
         if not np.all(np.isfinite(step)):
             break
         x = x + step
-        if np.max(np.abs(step[n_theta - 2:])) < _GN_WIND_TOL_MPS:
+        if np.max(np.abs(step[n_theta - 2:])) < GN_WIND_TOL_MPS:
             break
     return x
 
@@ -117,8 +100,7 @@ def _equations(parts, slices, x, n_theta, smooth):
         m = p.b.shape[1]
         gs = z.T @ r
         # the objective's GPS-noise spread term: the wind rows, and the drift rows (x B)
-        c, w = spread_weights(p.model, th, ch)
-        en, ee = c * w * (ch.vn - th[-2]), c * w * (ch.ve - th[-1])
+        en, ee = spread_gradient(p.model, th, ch)
         gs[n_theta - 2] += float(np.sum(en))
         gs[n_theta - 1] += float(np.sum(ee))
         gs[n_theta:n_theta + m] += p.b.T @ en
@@ -142,6 +124,6 @@ def joint_iv(parts, slices, x, n_theta, smooth):
         if not np.all(np.isfinite(step)):
             return x, False
         out = out - step
-        if np.max(np.abs(step / scales)) < _IV_TOL:
+        if np.max(np.abs(step / scales)) < IV_TOL:
             return out, True
     return x, False

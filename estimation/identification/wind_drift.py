@@ -33,8 +33,9 @@ from ..uncertainty.covariance import colored_covariance, known_gps_error, plain_
 from .residual import flight_channels, residual, sensitivities
 from .unknowns import WIND, to_reported
 
-__all__ = ["DEFAULT_KNOT_S", "DRIFT_MATTERS_MPS", "DRIFT_TEST_ALPHA", "WIND_MODES",
-           "DriftBasis", "check_wind_options", "constant_wind", "fit_wind"]
+__all__ = ["DEFAULT_KNOT_S", "DRIFT_MATTERS_MPS", "DRIFT_TEST_ALPHA", "GN_WIND_TOL_MPS",
+           "WIND_MODES", "DriftBasis", "check_wind_options", "constant_wind", "drift_columns",
+           "fit_wind", "gauss_newton_step", "shifted"]
 
 WIND_MODES = ("auto", "constant", "drifting")
 # Knot spacing of the drift, s: long against an orbit (1-3 min at 40-60 m/s on a 600-900 m
@@ -51,6 +52,8 @@ DRIFT_MATTERS_MPS = 1.0
 # Points of the reported wind track per knot interval
 TRACK_POINTS_PER_KNOT = 6
 _GN_ITERATIONS = 6
+# The joint Gauss-Newton has converged when the wind (mean and drift) moves less than this, m/s
+GN_WIND_TOL_MPS = 1e-4
 
 
 @dataclasses.dataclass(frozen=True)
@@ -174,20 +177,35 @@ def without_drift(flight, basis, d):
 
 def _whole_jacobian(model, theta, ch, b):
     """(r, S): the residual and its sensitivities to (theta, d_n, d_e) at the drift already
-    taken out of `ch`; the drift columns are the wind columns times B."""
+    taken out of `ch`."""
     jac = sensitivities(model, theta, *_args(ch))
     r = residual(model, theta, *_args(ch))
-    full = np.hstack([jac, jac[:, [-2]] * b, jac[:, [-1]] * b])
-    return r, full
+    return r, np.hstack([jac, drift_columns(jac, b)])
+
+
+def drift_columns(jac, b):
+    """The sensitivities to (d_n, d_e): the wind columns of `jac` (its last two) times B."""
+    return np.hstack([jac[:, [-2]] * b, jac[:, [-1]] * b])
 
 
 def _args(ch):
     return ch.qci, ch.vn, ch.ve, ch.air, ch.vd2, ch.c_eiv
 
 
-def _shifted(ch, b, d):
+def shifted(ch, b, d):
+    """Channels `ch` with the drift B d taken out of the GPS velocity (north, east)."""
     m = b.shape[1]
+    if m == 0:
+        return ch
     return dataclasses.replace(ch, vn=ch.vn - b @ d[:m], ve=ch.ve - b @ d[m:])
+
+
+def gauss_newton_step(jac, r):
+    """The Gauss-Newton step of the residual `r` with sensitivities `jac`, the columns scaled
+    to unit RMS for the least squares."""
+    scale = np.sqrt(np.mean(jac ** 2, axis=0))
+    scale[scale == 0] = 1.0
+    return np.linalg.lstsq(jac / scale, -r, rcond=None)[0] / scale
 
 
 def _joint_gauss_newton(model, theta, ch, b):
@@ -195,12 +213,10 @@ def _joint_gauss_newton(model, theta, ch, b):
     d = np.zeros(2 * b.shape[1])
     p = theta.size
     for _ in range(_GN_ITERATIONS):
-        r, jac = _whole_jacobian(model, theta, _shifted(ch, b, d), b)
-        scale = np.sqrt(np.mean(jac ** 2, axis=0))
-        scale[scale == 0] = 1.0
-        step = np.linalg.lstsq(jac / scale, -r, rcond=None)[0] / scale
+        r, jac = _whole_jacobian(model, theta, shifted(ch, b, d), b)
+        step = gauss_newton_step(jac, r)
         theta, d = theta + step[:p], d + step[p:]
-        if np.max(np.abs(step[p - 2:])) < 1e-4:        # m/s: the wind has settled
+        if np.max(np.abs(step[p - 2:])) < GN_WIND_TOL_MPS:
             break
     return theta, d
 
@@ -293,8 +309,8 @@ def fit_wind(flight, fit_constant, *, wind, knot_s, gps_noise_std_mps, air_data,
     basis = drift_basis(kept.time_s, kept.segment, knot_s)
     b = basis.rows(kept.time_s, kept.segment)
     theta, d = _joint_gauss_newton(model, result.internal_params, ch, b)
-    r = residual(model, theta, *_args(_shifted(ch, b, d)))
-    cov = _covariances(model, theta, _shifted(ch, b, d), b, r, fitted[-1], test_only=True)
+    r = residual(model, theta, *_args(shifted(ch, b, d)))
+    cov = _covariances(model, theta, shifted(ch, b, d), b, r, fitted[-1], test_only=True)
     p = theta.size
     test = wald_test(d, cov[0][p:, p:])
     if wind == "auto" and not test["p_value"] < DRIFT_TEST_ALPHA:
