@@ -69,6 +69,19 @@ def add_parser(subparsers):
     p.add_argument("--gps-noise-mps", type=float, default=None, metavar="SIGMA",
                    help="GPS velocity noise per component, m/s, for the errors-in-variables "
                         "correction (default: estimated from the data)")
+    _add_wind_arguments(p)
+    p.add_argument("--hides-threshold-kt", type=float, default=HIDES_THRESHOLD_KT, metavar="KT",
+                   help="say that the maneuver hides a change of scale (a leak) only when one "
+                        "the consistency checks would miss moves dV by more than KT "
+                        "(default %(default)s)")
+    _add_params_and_live(p)
+    add_budget_arguments(p, _help_constants)
+    _add_gps_error_arguments(p)
+    p.set_defaults(run=run)
+
+
+def _add_wind_arguments(p):
+    """The wind model's options (`estimation.identification.wind_drift`)."""
     p.add_argument("--wind", default="auto", metavar="MODEL",
                    help="wind model: constant, drifting (a wind varying slowly in time, "
                         "piecewise linear between knots) or auto: drifting when a Wald test "
@@ -77,13 +90,10 @@ def add_parser(subparsers):
     p.add_argument("--wind-knot-s", type=float, default=None, metavar="S",
                    help="knot spacing of the drifting wind, s (default: 300 s, or two of the "
                         "flight's orbits when it turns more slowly)")
-    p.add_argument("--hides-threshold-kt", type=float, default=HIDES_THRESHOLD_KT, metavar="KT",
-                   help="say that the maneuver hides a change of scale (a leak) only when one "
-                        "the consistency checks would miss moves dV by more than KT "
-                        "(default %(default)s)")
-    _add_params_and_live(p)
-    add_budget_arguments(p, _help_constants)
-    # --- the GPS receiver's time-correlated velocity error, stated ---
+
+
+def _add_gps_error_arguments(p):
+    """The GPS receiver's time-correlated velocity error, stated (a known term of the bounds)."""
     gps = p.add_argument_group("GPS velocity error (a known term of the bounds)")
     gps.add_argument("--gps-error-sigma-mps", type=float, default=None, metavar="SIGMA",
                      help="the GPS receiver's slowly varying velocity error per component, "
@@ -92,7 +102,6 @@ def add_parser(subparsers):
                           "looks like wind); with --gps-error-tau-s; default: none stated")
     gps.add_argument("--gps-error-tau-s", type=float, default=None, metavar="S",
                      help="its correlation time, s (e.g. 30); with --gps-error-sigma-mps")
-    p.set_defaults(run=run)
 
 
 def _add_params_and_live(p):
